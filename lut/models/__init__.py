@@ -1,0 +1,26 @@
+"""Germer's polarized light-scattering models of glossy and matte paints
+(T. A. Germer, "Polarized light diffusely scattered under smooth and rough
+interfaces"), as vectorized numpy functions returning Mueller BSDFs [sr⁻¹].
+
+See docs/models.md for conventions, deviations from the paper and accuracy."""
+
+from .facet import facet_reflection, facet_transmission
+from .fresnel import internal_reflectance
+from .rough import rough_diffuse, rough_internal_reflectance, rough_single, rough_single_random
+from .smooth import smooth_diffuse, smooth_single
+from .mueller import STOKES_45, jones_to_mueller, polarization_parameters
+
+__all__ = [
+    "STOKES_45",
+    "facet_reflection",
+    "facet_transmission",
+    "internal_reflectance",
+    "jones_to_mueller",
+    "polarization_parameters",
+    "rough_diffuse",
+    "rough_internal_reflectance",
+    "rough_single",
+    "rough_single_random",
+    "smooth_diffuse",
+    "smooth_single",
+]

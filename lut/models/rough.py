@@ -1,0 +1,422 @@
+"""Volume scattering under a rough interface (paper Sec. 2.5).
+
+The paper averages the smooth-interface models over ~5000 random pairs of
+facet normals per direction pair, one normal drawn for the incident ray and one
+for the scattered ray from the slope distribution as seen by that ray
+(Eq. 36).  Here the same average is computed by deterministic quadrature:
+
+* **Visible-normal rule.**  For a direction u (towards the source or the
+  viewer) the facets it meets have density P(ζ) max(cos ι, 0) sec θn per
+  dζx dζy (Eq. 36), normalized exactly (each ray meets one facet; the paper's
+  Eq. 37 approximates the normalization by cos θ).  We integrate it with a
+  product Gauss rule: Gauss-Legendre in the radial slope ζ for the measure
+  2πζP(ζ)dζ (``distributions.radial_rule``) times Gauss-Legendre in the facet
+  azimuth over the arc where cos ι > 0.  The rule moves smoothly with the
+  direction, so results are smooth in angle, and it is deterministic, so no
+  seed is needed.
+
+* **Diffuse term** (Eq. 21 under a rough interface).  The substrate is
+  depolarizing and its emitted radiance is uniform, so the BRDF factors:
+
+      f = ρ / (π n² (1 - ρ r̄)) · c(θs) r(θi)ᵀ,
+
+  r(θ) the first row of the facet-averaged entry transmittance Mueller matrix,
+  c(θ) the first column of the exit one (by reciprocity the same functions),
+  r̄ = 1 - (2/n²) ∫ r₀(θ) cos θ sin θ dθ the rough interface's internal
+  hemispherical reflectance for diffuse light (the n² radiance law).  With a
+  smooth interface this is exactly Eqs. 22-28.
+
+* **Single-scatter term** (Eq. 7 under a rough interface).  For entry facet a
+  and exit facet b, the internal directions follow from Snell's law at each
+  facet, and the smooth-interface derivation of Eq. 20 carries over:
+
+      f = Σ_ab w_a w_b · (T_a T_b / n²) · 2p(θ_ab) / (1 + cos²θ_ab)
+            / (|cos θ'_a| + |cos θ'_b|) · M(J_b V_ab J_a),
+
+  T the facets' beam transmittance factors n cos ι'/cos ι, θ'_a, θ'_b the
+  internal angles to the mean normal (depth is measured along it), J_a, J_b
+  the facet transmission Jones matrices and V_ab the projection dyadic (Eq. 4)
+  in the internal s/p bases.  All N_entry × N_exit pairs are used.  Pairs
+  whose refracted ray would travel back towards the surface are dropped.
+
+Neither term includes shadowing, or rays that cross the interface more than
+once, as in the paper.
+"""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from . import _validate, distributions, fresnel, geometry, phase, smooth
+from .geometry import cross, dot
+from .mueller import jones_to_mueller
+
+#: Default (radial nodes per segment, azimuthal nodes) of the visible-normal
+#: rule; see docs/models.md for the error each reaches.
+DIFFUSE_NODES = (16, 16)
+SINGLE_NODES = (4, 6)
+#: Above this many distinct polar angles the 1-D diffuse functions are
+#: tabulated on a uniform grid and interpolated linearly.
+TABLE_SIZE = 2049
+#: Pairs evaluated per chunk in the single-scatter sum (bounds memory).
+CHUNK_PAIRS = 1 << 21
+
+
+def visible_normals(theta, slope: float, distribution: str, nodes):
+    """Visible-normal quadrature rule for directions u = (sin θ, 0, cos θ).
+
+    A facet with slope ζ at azimuth φ (from u's azimuth) faces u where
+    cos θ + ζ sin θ cos φ > 0, i.e. for every φ while ζ < cot θ and on an arc
+    |φ| < arccos(-cot θ / ζ) beyond.  The radial integral is split at
+    ζ = cot θ (``distributions.split_radial_rule``): inside, the azimuth runs
+    over the whole circle (periodic trapezoid rule, spectrally accurate);
+    outside, over the visible arc (Gauss-Legendre).  Each facet's weight is
+    its share of the projected area, max(cos ι, 0) sec θn (Eq. 36), and the
+    weights are normalized to sum to 1.
+
+    ``nodes`` = (radial nodes per segment, azimuthal nodes).  Returns (h, w):
+    facet normals (..., M, 3) and weights (..., M), M = 2 · nodes[0] · nodes[1];
+    the weights are 0 for θ >= π/2."""
+    n_zeta, n_phi = nodes
+    theta = np.asarray(theta, dtype=float)
+    cos_t = np.cos(theta)
+    sin_t = np.sin(theta)
+    with np.errstate(divide="ignore"):
+        zeta_c = np.where(sin_t > 0.0, cos_t / np.where(sin_t > 0.0, sin_t, 1.0), np.inf)
+    t_c = distributions.radial_variable(zeta_c, slope, distribution)
+    zeta, w_zeta = distributions.split_radial_rule(t_c, slope, distribution, n_zeta)
+    cos_t, sin_t = cos_t[..., None], sin_t[..., None]
+    reach = zeta * sin_t
+    clipped = reach > cos_t
+    ratio = -cos_t / np.where(clipped, reach, 1.0)
+    half = np.where(clipped, np.arccos(np.clip(ratio, -1.0, 1.0)), np.pi)
+    x, w_x = np.polynomial.legendre.leggauss(n_phi)
+    trap = (2.0 * np.arange(n_phi) + 1.0) / n_phi - 1.0  # periodic trapezoid on [-1, 1)
+    unit = np.where(clipped[..., None], x, trap)
+    w_unit = np.where(clipped[..., None], w_x, 2.0 / n_phi)
+    phi = half[..., None] * unit
+    w_phi = half[..., None] * w_unit / (2.0 * np.pi)
+    zeta_ = zeta[..., None]
+    proj = np.clip(cos_t[..., None] + zeta_ * sin_t[..., None] * np.cos(phi), 0.0, None)
+    w = (w_zeta[..., None] * w_phi * proj).reshape(theta.shape + (-1,))
+    total = w.sum(axis=-1, keepdims=True)
+    w = np.where(total > 0.0, w / np.where(total > 0.0, total, 1.0), 0.0)
+    norm = np.sqrt(1.0 + zeta_ * zeta_)
+    zeta_b = np.broadcast_to(zeta_, phi.shape)
+    h = np.stack(
+        (zeta_b * np.cos(phi) / norm, zeta_b * np.sin(phi) / norm, np.broadcast_to(1.0 / norm, phi.shape)),
+        axis=-1,
+    ).reshape(theta.shape + (-1, 3))
+    return h, w
+
+
+def _entry_states(theta_i, n, slope, distribution, nodes):
+    """Rays entering the binder through the visible facets, for incident
+    directions k_i (source at azimuth π).  Returns a dict of arrays (..., M)."""
+    h, w = visible_normals(theta_i, slope, distribution, nodes)
+    h = h * np.array([-1.0, 1.0, 1.0])  # the source sits at azimuth π
+    k = geometry.incident(theta_i)[..., None, :]
+    cos_i = np.clip(-dot(k, h), 0.0, 1.0)
+    k_in, cos_t, ok = geometry.refract(k, h, n, cos_i)
+    t_s, t_p, _ = fresnel.transmission_coefficients(cos_i, n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        beam = np.where(ok & (cos_i > 0.0), n * cos_t / np.where(cos_i > 0, cos_i, 1.0), 0.0)
+    return {"h": h, "w": w, "k": np.broadcast_to(k, h.shape), "k_in": k_in, "t_s": t_s, "t_p": t_p, "beam": beam}
+
+
+def _exit_states(theta_s, n, slope, distribution, nodes):
+    """Rays leaving the binder through the visible facets towards
+    k_s = (sin θs, 0, cos θs) (azimuth 0; rotate for other azimuths).  By
+    reciprocity the exit is the entry of the reversed ray -k_s: the internal
+    ray is k_in = -refract(-k_s), and the coefficients are the air-side ones
+    (paper Eqs. 11, 25)."""
+    h, w = visible_normals(theta_s, slope, distribution, nodes)
+    k = geometry.scattered(theta_s, 0.0)[..., None, :]
+    cos_i = np.clip(dot(k, h), 0.0, 1.0)
+    k_rev, cos_t, ok = geometry.refract(-k, h, n, cos_i)
+    t_s, t_p, _ = fresnel.transmission_coefficients(cos_i, n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        beam = np.where(ok & (cos_i > 0.0), n * cos_t / np.where(cos_i > 0, cos_i, 1.0), 0.0)
+    return {"h": h, "w": w, "k": np.broadcast_to(k, h.shape), "k_in": -k_rev, "t_s": t_s, "t_p": t_p, "beam": beam}
+
+
+# --------------------------------------------------------------------------- diffuse
+
+
+def _transmittance_rows(theta, n, slope, distribution, nodes):
+    """Facet-averaged first row of the entry transmittance Mueller matrix
+    (= first column of the exit one), shape (..., 4)."""
+    st = _entry_states(theta, n, slope, distribution, nodes)
+    basis_a = geometry.sp_basis(st["k"])
+    basis_b = geometry.sp_basis(st["k_in"])
+    jones = geometry.interface_jones(st["k"], st["k_in"], st["h"], st["t_s"], st["t_p"], basis_a, basis_b)
+    m = jones_to_mueller(jones)[..., 0, :]
+    return np.sum((st["w"] * st["beam"])[..., None] * m, axis=-2)
+
+
+@functools.lru_cache(maxsize=64)
+def rough_internal_reflectance(n: float, slope: float, distribution: str, nodes=DIFFUSE_NODES, theta_nodes=96):
+    """Internal hemispherical reflectance r̄ of the rough interface for
+    diffuse light inside the binder (the rough counterpart of Eq. 22):
+    r̄ = 1 - (2/n²) ∫₀^{π/2} τ(θ) cos θ sin θ dθ, τ the facet-averaged
+    transmittance from air, by reciprocity and the n² radiance law."""
+    x, w = np.polynomial.legendre.leggauss(theta_nodes)
+    theta = 0.25 * np.pi * (x + 1.0)
+    tau = _transmittance_rows(theta, n, slope, distribution, nodes)[..., 0]
+    integral = np.sum(0.25 * np.pi * w * tau * np.cos(theta) * np.sin(theta))
+    return float(1.0 - 2.0 * integral / (n * n))
+
+
+def _rows_at(theta, n, slope, distribution, nodes):
+    """Transmittance rows at arbitrary polar angles: computed at the distinct
+    values, or interpolated from a fine table when there are many."""
+    flat = theta.ravel()
+    uniq, inverse = np.unique(flat, return_inverse=True)
+    if uniq.size <= TABLE_SIZE:
+        rows = _transmittance_rows(uniq, n, slope, distribution, nodes)[inverse]
+    else:
+        grid = np.linspace(0.0, np.pi / 2, TABLE_SIZE)
+        table = _transmittance_rows(grid, n, slope, distribution, nodes)
+        rows = np.stack([np.interp(flat, grid, table[:, c]) for c in range(4)], axis=-1)
+    rows = np.where((flat < np.pi / 2)[:, None], rows, 0.0)
+    return rows.reshape(theta.shape + (4,))
+
+
+def rough_diffuse(
+    theta_i, theta_s, phi_s, *, n, rho, slope, distribution="gaussian", mueller=True, nodes=DIFFUSE_NODES
+):
+    """Mueller BRDF [sr⁻¹] of a totally diffuse substrate (reflectance rho)
+    under a rough interface (paper Sec. 2.5 with Eq. 21; see the module
+    docstring for the factorization and its derivation).
+
+    Parameters: angles in radians; n (> 0); rho in [0, 1]; slope the total
+    RMS slope (>= 0; 0 gives ``smooth_diffuse``); distribution 'gaussian' |
+    'exponential'; nodes the (radial, azimuthal) sizes of the visible-normal
+    rule.  Returns broadcast(angles) + (4, 4), or M00 with ``mueller=False``.
+    The result does not depend on phi_s."""
+    n = _validate.index(n)
+    rho = _validate.reflectance(rho)
+    slope = _validate.rms_slope(slope)
+    distribution = _validate.distribution(distribution)
+    nodes = (_validate.positive_int(nodes[0], "nodes[0]"), _validate.positive_int(nodes[1], "nodes[1]"))
+    ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s)
+    if slope == 0.0:
+        return smooth.smooth_diffuse(ti, ts, ps, n=n, rho=rho, mueller=mueller)
+    rbar = rough_internal_reflectance(n, slope, distribution, nodes)
+    k = rho / (np.pi * n * n * (1.0 - rho * rbar))
+    row = _rows_at(ti, n, slope, distribution, nodes)
+    col = _rows_at(ts, n, slope, distribution, nodes)
+    if not mueller:
+        return k * col[..., 0] * row[..., 0]
+    # The exit column is the reciprocal of the entry row: equal I and Q parts;
+    # U and V vanish by the mirror symmetry of the visible facets.
+    return k * col[..., :, None] * row[..., None, :]
+
+
+# --------------------------------------------------------------------------- single
+
+
+def _local_basis(k_ext, k_int, h):
+    """Local s vector of the facet and the p vectors of the external and the
+    internal ray (paper Eq. 40); the s vector falls back to the global one at
+    normal incidence on the facet, where the choice does not matter."""
+    s_glob, _ = geometry.sp_basis(k_ext)
+    s_loc, _ = geometry.unit_or(cross(k_ext, h), s_glob)
+    return s_loc, cross(k_ext, s_loc), cross(k_int, s_loc)
+
+
+def _rotate_z(v, cos_p, sin_p):
+    x, y = v[..., 0], v[..., 1]
+    return np.stack((x * cos_p - y * sin_p, x * sin_p + y * cos_p, v[..., 2]), axis=-1)
+
+
+def _gather(states, index):
+    return {key: val[index] for key, val in states.items()}
+
+
+def rough_single(
+    theta_i, theta_s, phi_s, *, n, g, slope, distribution="gaussian", mueller=True, nodes=SINGLE_NODES
+):
+    """Mueller BRDF [sr⁻¹] of single volume scattering with the polarimetric
+    Henyey-Greenstein phase function (Eq. 7) under a rough interface (paper
+    Sec. 2.5; see the module docstring).
+
+    Parameters: angles in radians; n (> 0); g in (-1, 1); slope (>= 0; 0
+    gives ``smooth_single``); distribution; nodes the (radial, azimuthal)
+    sizes of the visible-normal rule used for both the entry and the exit
+    facets (all pairs are summed).  Returns broadcast(angles) + (4, 4), or M00
+    with ``mueller=False``."""
+    n = _validate.index(n)
+    g = _validate.asymmetry(g)
+    slope = _validate.rms_slope(slope)
+    distribution = _validate.distribution(distribution)
+    nodes = (_validate.positive_int(nodes[0], "nodes[0]"), _validate.positive_int(nodes[1], "nodes[1]"))
+    ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s)
+    if slope == 0.0:
+        return smooth.smooth_single(ti, ts, ps, n=n, g=g, mueller=mueller)
+    return _single_sum(ti, ts, ps, n, g, slope, distribution, nodes, nodes, mueller)
+
+
+def _prepare_entry(theta, n, slope, distribution, nodes):
+    st = _entry_states(theta, n, slope, distribution, nodes)
+    s_loc, p_ext, p_int = _local_basis(st["k"], st["k_in"], st["h"])
+    down = st["k_in"][..., 2] < 0.0
+    st["weight"] = np.where(down, st["w"] * st["beam"], 0.0)
+    st["depth"] = np.abs(st["k_in"][..., 2])
+    st["s"], st["p"] = s_loc, p_int
+    s_a, p_a = geometry.sp_basis(st["k"])
+    # A = diag(t_s, t_p) · R_in, global s/p of k_i -> local s/p inside.
+    st["A"] = np.stack(
+        (
+            np.stack((st["t_s"] * dot(s_loc, s_a), st["t_s"] * dot(s_loc, p_a)), -1),
+            np.stack((st["t_p"] * dot(p_ext, s_a), st["t_p"] * dot(p_ext, p_a)), -1),
+        ),
+        -2,
+    )
+    return st
+
+
+def _prepare_exit(theta, n, slope, distribution, nodes):
+    st = _exit_states(theta, n, slope, distribution, nodes)
+    s_loc, p_ext, p_int = _local_basis(st["k"], st["k_in"], st["h"])
+    up = st["k_in"][..., 2] > 0.0
+    st["weight"] = np.where(up, st["w"] * st["beam"], 0.0)
+    st["depth"] = np.abs(st["k_in"][..., 2])
+    st["s"], st["p"] = s_loc, p_int
+    s_b, p_b = geometry.sp_basis(st["k"])
+    # B = R_out · diag(t_s, t_p), local s/p inside -> global s/p of k_s.  The
+    # global basis at φs = 0 rotates rigidly with the azimuth (for θs > 0).
+    st["B"] = np.stack(
+        (
+            np.stack((dot(s_b, s_loc) * st["t_s"], dot(s_b, p_ext) * st["t_p"]), -1),
+            np.stack((dot(p_b, s_loc) * st["t_s"], dot(p_b, p_ext) * st["t_p"]), -1),
+        ),
+        -2,
+    )
+    return st
+
+
+def _single_sum(ti, ts, ps, n, g, slope, distribution, nodes_in, nodes_out, mueller):
+    shape = ti.shape
+    ti, ts, ps = ti.ravel(), ts.ravel(), ps.ravel()
+    ui, inv_i = np.unique(ti, return_inverse=True)
+    us, inv_s = np.unique(ts, return_inverse=True)
+    entry = _prepare_entry(ui, n, slope, distribution, nodes_in)
+    exit_ = _prepare_exit(us, n, slope, distribution, nodes_out)
+    m_in, m_out = entry["w"].shape[-1], exit_["w"].shape[-1]
+    lit = (ti < np.pi / 2) & (ts < np.pi / 2)
+    # At θs = 0 the global s/p basis of k_s is ŷ/-x̂ whatever φs: do not rotate it.
+    basis_rot = ts > 0.0
+    out = np.zeros(ti.shape + ((4, 4) if mueller else ()))
+    chunk = max(1, CHUNK_PAIRS // (m_in * m_out))
+    for start in range(0, ti.size, chunk):
+        sl = slice(start, start + chunk)
+        a = _gather(entry, inv_i[sl])
+        b = _gather(exit_, inv_s[sl])
+        cp, sp = np.cos(ps[sl])[:, None], np.sin(ps[sl])[:, None]
+        k2, s2, p2 = (_rotate_z(b[key], cp, sp) for key in ("k_in", "s", "p"))
+        # All pairwise dot products in one batched matrix product.
+        left = np.concatenate((a["k_in"], a["s"], a["p"]), axis=1)  # (C, 3M, 3)
+        right = np.concatenate((k2, s2, p2), axis=1)  # (C, 3N, 3)
+        d = np.matmul(left, right.transpose(0, 2, 1)).reshape(-1, 3, m_in, 3, m_out)
+        cos_sc = np.clip(d[:, 0, :, 0, :], -1.0, 1.0)
+        v_ss, v_sp = d[:, 1, :, 1, :], d[:, 2, :, 1, :]
+        v_ps, v_pp = d[:, 1, :, 2, :], d[:, 2, :, 2, :]
+        weight = (
+            a["weight"][:, :, None]
+            * b["weight"][:, None, :]
+            * phase.rayleigh_factor(cos_sc, g)
+            / (n * n * (a["depth"][:, :, None] + b["depth"][:, None, :]))
+        )
+        if not mueller:
+            t1s, t1p = (a[key][:, :, None] ** 2 for key in ("t_s", "t_p"))
+            t2s, t2p = (b[key][:, None, :] ** 2 for key in ("t_s", "t_p"))
+            m00 = 0.5 * (t2s * (v_ss**2 * t1s + v_sp**2 * t1p) + t2p * (v_ps**2 * t1s + v_pp**2 * t1p))
+            out[sl] = np.sum(weight * m00, axis=(1, 2))
+            continue
+        v = np.stack((np.stack((v_ss, v_sp), -1), np.stack((v_ps, v_pp), -1)), -2)
+        bmat = b["B"]
+        # Rotating the exit states by φs leaves B unchanged except at θs = 0,
+        # where the global basis stays fixed while the local one turns.
+        rot = ~basis_rot[sl]
+        if np.any(rot):
+            c1, s1 = cp[rot, :, None, None], sp[rot, :, None, None]
+            r = np.concatenate(
+                (np.concatenate((c1, s1), -1), np.concatenate((-s1, c1), -1)), -2
+            )  # (c, 1, 2, 2): rotation of the s/p components by -φs
+            bmat = bmat.copy()
+            bmat[rot] = np.matmul(r, bmat[rot])
+        jones = np.matmul(np.matmul(bmat[:, None, :, :, :], v), a["A"][:, :, None, :, :])
+        out[sl] = np.sum(weight[..., None, None] * jones_to_mueller(jones), axis=(1, 2))
+    out[~lit] = 0.0
+    return out.reshape(shape + ((4, 4) if mueller else ()))
+
+
+# --------------------------------------------------------------------------- paper's method
+
+
+def _area_normals(rng, shape, slope, distribution):
+    """Random facet normals distributed as P(ζ) dζx dζy (uniform on the mean
+    plane), the paper's first random surface-normal generator."""
+    if distribution == "gaussian":
+        zeta = slope * np.sqrt(rng.standard_exponential(shape))
+    else:
+        zeta = slope * rng.standard_gamma(2.0, shape) / distributions.SQRT6
+    phi = rng.uniform(-np.pi, np.pi, shape)
+    norm = np.sqrt(1.0 + zeta * zeta)
+    return np.stack((zeta * np.cos(phi) / norm, zeta * np.sin(phi) / norm, 1.0 / norm), axis=-1)
+
+
+def rough_single_random(theta_i, theta_s, phi_s, *, n, g, slope, distribution="gaussian", pairs=5000, seed=0):
+    """M00 of ``rough_single`` by the paper's Monte Carlo method (Sec. 2.5):
+    for every direction pair, ``pairs`` independent pairs of random facet
+    normals, one met by the incident and one by the scattered ray, averaged.
+    Kept as the baseline of the benchmark (scripts/benchmark_models.py); the
+    quadrature of ``rough_single`` is the production path.
+
+    The normals seen by a ray are drawn from the area distribution and
+    weighted by their projected area max(cos ι, 0) sec θn (Eq. 36) with a
+    self-normalized average, rather than by the paper's rejection step;
+    both sample the same distribution."""
+    n = _validate.index(n)
+    g = _validate.asymmetry(g)
+    slope = _validate.rms_slope(slope)
+    distribution = _validate.distribution(distribution)
+    pairs = _validate.positive_int(pairs, "pairs")
+    ti, ts, ps = (a.ravel() for a in _validate.angles(theta_i, theta_s, phi_s))
+    shape = np.broadcast(theta_i, theta_s, phi_s).shape
+    rng = np.random.default_rng(seed)
+    out = np.zeros(ti.shape)
+    chunk = max(1, CHUNK_PAIRS // pairs)
+    for start in range(0, ti.size, chunk):
+        sl = slice(start, start + chunk)
+        k_i = geometry.incident(ti[sl])[:, None, :]
+        k_s = geometry.scattered(ts[sl], ps[sl])[:, None, :]
+        h1 = _area_normals(rng, (k_i.shape[0], pairs), slope, distribution)
+        h2 = _area_normals(rng, (k_i.shape[0], pairs), slope, distribution)
+        w1 = np.clip(-dot(k_i, h1), 0.0, None) / h1[..., 2]
+        w2 = np.clip(dot(k_s, h2), 0.0, None) / h2[..., 2]
+        cos1, cos2 = np.clip(-dot(k_i, h1), 0.0, 1.0), np.clip(dot(k_s, h2), 0.0, 1.0)
+        k1, c1t, ok1 = geometry.refract(k_i, h1, n, cos1)
+        k2r, c2t, ok2 = geometry.refract(-k_s, h2, n, cos2)
+        k2 = -k2r
+        t1s, t1p, _ = fresnel.transmission_coefficients(cos1, n)
+        t2s, t2p, _ = fresnel.transmission_coefficients(cos2, n)
+        s1, _, p1 = _local_basis(np.broadcast_to(k_i, k1.shape), k1, h1)
+        s2, _, p2 = _local_basis(np.broadcast_to(k_s, k2.shape), k2, h2)
+        good = ok1 & ok2 & (k1[..., 2] < 0.0) & (k2[..., 2] > 0.0) & (cos1 > 0.0) & (cos2 > 0.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            beam = np.where(good, n * c1t / cos1 * n * c2t / cos2, 0.0)
+        cos_sc = np.clip(dot(k1, k2), -1.0, 1.0)
+        m00 = 0.5 * (
+            t2s**2 * (dot(s2, s1) ** 2 * t1s**2 + dot(s2, p1) ** 2 * t1p**2)
+            + t2p**2 * (dot(p2, s1) ** 2 * t1s**2 + dot(p2, p1) ** 2 * t1p**2)
+        )
+        value = beam * phase.rayleigh_factor(cos_sc, g) * m00 / (n * n * (np.abs(k1[..., 2]) + np.abs(k2[..., 2])))
+        norm = np.sum(w1, axis=1) * np.sum(w2, axis=1) / pairs
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out[sl] = np.where(norm > 0, np.sum(w1 * w2 * value, axis=1) / np.where(norm > 0, norm, 1.0), 0.0)
+    lit = (ti < np.pi / 2) & (ts < np.pi / 2)
+    return np.where(lit, out, 0.0).reshape(shape)
