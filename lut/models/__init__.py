@@ -6,9 +6,9 @@ See docs/models.md for conventions, deviations from the paper and accuracy."""
 
 from .facet import facet_reflection, facet_transmission
 from .fresnel import internal_reflectance
+from .mueller import STOKES_45, jones_to_mueller, polarization_parameters
 from .rough import rough_diffuse, rough_internal_reflectance, rough_single, rough_single_random
 from .smooth import smooth_diffuse, smooth_single
-from .mueller import STOKES_45, jones_to_mueller, polarization_parameters
 
 __all__ = [
     "STOKES_45",

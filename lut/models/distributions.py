@@ -25,6 +25,7 @@ def pdf(zeta, slope: float, distribution: str):
     return 3.0 / (np.pi * s2) * np.exp(-SQRT6 * z / slope)
 
 
+@functools.lru_cache(maxsize=32)
 def _laguerre_rule(nodes: int, alpha: float):
     """Gauss rule for the weight x^alpha e^-x on [0, ∞) by the Golub-Welsch
     eigenvalue method (recurrence a_k = 2k + alpha + 1, b_k = k (k + alpha)).
@@ -34,7 +35,10 @@ def _laguerre_rule(nodes: int, alpha: float):
     off = np.sqrt(k[1:] * (k[1:] + alpha))
     jacobi = np.diag(diag) + np.diag(off, 1) + np.diag(off, -1)
     x, vec = np.linalg.eigh(jacobi)
-    return x, vec[0] ** 2
+    w = vec[0] ** 2
+    x.setflags(write=False)
+    w.setflags(write=False)
+    return x, w
 
 
 #: Split cap in the radial variable t (see ``split_radial_rule``): beyond it

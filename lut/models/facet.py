@@ -64,9 +64,7 @@ def facet_reflection(theta_i, theta_s, phi_s, *, n, slope, distribution="gaussia
     rs, rp = fresnel.reflection_coefficients(cos_iota, n)
     if not mueller:
         return scale * 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)
-    jones = geometry.interface_jones(
-        k_i, k_s, h, rs, rp, geometry.sp_basis(k_i), geometry.sp_basis(k_s)
-    )
+    jones = geometry.interface_jones(k_i, k_s, h, rs, rp, geometry.sp_basis(k_i), geometry.sp_basis(k_s))
     return scale[..., None, None] * jones_to_mueller(jones)
 
 
@@ -119,7 +117,5 @@ def facet_transmission(theta_i, theta_t, phi_t, *, n, slope, distribution="gauss
         )
     if not mueller:
         return scale * 0.5 * (ts_ * ts_ + tp_ * tp_)
-    jones = geometry.interface_jones(
-        k_i, k_t, h, ts_, tp_, geometry.sp_basis(k_i), geometry.sp_basis(k_t)
-    )
+    jones = geometry.interface_jones(k_i, k_t, h, ts_, tp_, geometry.sp_basis(k_i), geometry.sp_basis(k_t))
     return scale[..., None, None] * jones_to_mueller(jones)

@@ -28,8 +28,11 @@ def reflection_coefficients(cos_i, n):
     """Amplitude reflection coefficients (r_s, r_p) for light incident from
     air (index 1) at a local angle with cosine ``cos_i`` onto index n.
 
-    Complex where n < 1 and the angle exceeds the critical angle (|r| = 1)."""
+    Complex where n < 1 and the angle exceeds the critical angle (|r| = 1).
+    With n = 1 there is no interface and both are 0."""
     cos_i = np.asarray(cos_i, dtype=float)
+    if n == 1.0:
+        return np.zeros_like(cos_i), np.zeros_like(cos_i)
     if n < 1.0:
         cos_t = cos_refracted(cos_i.astype(complex), n)
     else:
@@ -44,15 +47,16 @@ def transmission_coefficients(cos_i, n):
     from air into index n at a local angle with cosine ``cos_i``.
 
     Zero under total internal reflection (n < 1 beyond the critical angle),
-    where no power crosses the interface.  The beam (power) transmittance is
-    n cos_t / cos_i · |t|² (paper Eqs. 24, 42)."""
+    where no power crosses the interface, and for cos_i <= 0 (at or below the
+    horizon).  The beam (power) transmittance is n cos_t / cos_i · |t|²
+    (paper Eqs. 24, 42)."""
     cos_i = np.asarray(cos_i, dtype=float)
     sin2_t = (1.0 - cos_i * cos_i) / (n * n)
-    ok = sin2_t < 1.0
+    ok = (sin2_t < 1.0) & (cos_i > 0.0)
     cos_t = np.sqrt(np.clip(1.0 - sin2_t, 0.0, None))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ts = np.where(ok, 2.0 * cos_i / (cos_i + n * cos_t), 0.0)
-        tp = np.where(ok, 2.0 * cos_i / (n * cos_i + cos_t), 0.0)
+    c = np.where(ok, cos_i, 1.0)
+    ts = np.where(ok, 2.0 * c / (c + n * cos_t), 0.0)
+    tp = np.where(ok, 2.0 * c / (n * c + cos_t), 0.0)
     return ts, tp, cos_t
 
 

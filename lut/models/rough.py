@@ -84,13 +84,15 @@ def visible_normals(theta, slope: float, distribution: str, nodes):
     cos_t = np.cos(theta)
     sin_t = np.sin(theta)
     with np.errstate(divide="ignore"):
-        zeta_c = np.where(sin_t > 0.0, cos_t / np.where(sin_t > 0.0, sin_t, 1.0), np.inf)
+        # Directions at or below the horizon see facets only on arcs (and get
+        # zero weight below); keep the split point at ζ >= 0.
+        zeta_c = np.where(sin_t > 0.0, np.clip(cos_t, 0.0, None) / np.where(sin_t > 0.0, sin_t, 1.0), np.inf)
     t_c = distributions.radial_variable(zeta_c, slope, distribution)
     zeta, w_zeta = distributions.split_radial_rule(t_c, slope, distribution, n_zeta)
     cos_t, sin_t = cos_t[..., None], sin_t[..., None]
     reach = zeta * sin_t
     clipped = reach > cos_t
-    ratio = -cos_t / np.where(clipped, reach, 1.0)
+    ratio = -cos_t / np.where(clipped & (reach > 0.0), reach, 1.0)
     half = np.where(clipped, np.arccos(np.clip(ratio, -1.0, 1.0)), np.pi)
     x, w_x = np.polynomial.legendre.leggauss(n_phi)
     trap = (2.0 * np.arange(n_phi) + 1.0) / n_phi - 1.0  # periodic trapezoid on [-1, 1)
@@ -236,9 +238,7 @@ def _gather(states, index):
     return {key: val[index] for key, val in states.items()}
 
 
-def rough_single(
-    theta_i, theta_s, phi_s, *, n, g, slope, distribution="gaussian", mueller=True, nodes=SINGLE_NODES
-):
+def rough_single(theta_i, theta_s, phi_s, *, n, g, slope, distribution="gaussian", mueller=True, nodes=SINGLE_NODES):
     """Mueller BRDF [sr⁻¹] of single volume scattering with the polarimetric
     Henyey-Greenstein phase function (Eq. 7) under a rough interface (paper
     Sec. 2.5; see the module docstring).
@@ -324,11 +324,12 @@ def _single_sum(ti, ts, ps, n, g, slope, distribution, nodes_in, nodes_out, muel
         cos_sc = np.clip(d[:, 0, :, 0, :], -1.0, 1.0)
         v_ss, v_sp = d[:, 1, :, 1, :], d[:, 2, :, 1, :]
         v_ps, v_pp = d[:, 1, :, 2, :], d[:, 2, :, 2, :]
+        depth = a["depth"][:, :, None] + b["depth"][:, None, :]
+        # Eq. 19: 1/(cos θ'1 + cos θ'2); both cosines vanish only for grazing
+        # internal rays, whose weights are already zero.
+        inv_depth = np.divide(1.0, depth, out=np.zeros_like(depth), where=depth > 0.0)
         weight = (
-            a["weight"][:, :, None]
-            * b["weight"][:, None, :]
-            * phase.rayleigh_factor(cos_sc, g)
-            / (n * n * (a["depth"][:, :, None] + b["depth"][:, None, :]))
+            a["weight"][:, :, None] * b["weight"][:, None, :] * phase.rayleigh_factor(cos_sc, g) * inv_depth / (n * n)
         )
         if not mueller:
             t1s, t1p = (a[key][:, :, None] ** 2 for key in ("t_s", "t_p"))
@@ -414,7 +415,9 @@ def rough_single_random(theta_i, theta_s, phi_s, *, n, g, slope, distribution="g
             t2s**2 * (dot(s2, s1) ** 2 * t1s**2 + dot(s2, p1) ** 2 * t1p**2)
             + t2p**2 * (dot(p2, s1) ** 2 * t1s**2 + dot(p2, p1) ** 2 * t1p**2)
         )
-        value = beam * phase.rayleigh_factor(cos_sc, g) * m00 / (n * n * (np.abs(k1[..., 2]) + np.abs(k2[..., 2])))
+        depth = np.abs(k1[..., 2]) + np.abs(k2[..., 2])
+        inv_depth = np.divide(1.0, depth, out=np.zeros_like(depth), where=depth > 0.0)
+        value = beam * phase.rayleigh_factor(cos_sc, g) * m00 * inv_depth / (n * n)
         norm = np.sum(w1, axis=1) * np.sum(w2, axis=1) / pairs
         with np.errstate(divide="ignore", invalid="ignore"):
             out[sl] = np.where(norm > 0, np.sum(w1 * w2 * value, axis=1) / np.where(norm > 0, norm, 1.0), 0.0)

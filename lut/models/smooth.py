@@ -16,7 +16,10 @@ def _refracted_cosines(ti, ts, n):
     cos_i, cos_s = np.cos(ti), np.cos(ts)
     ts_i, tp_i, cos_ip = fresnel.transmission_coefficients(cos_i, n)
     ts_s, tp_s, cos_sp = fresnel.transmission_coefficients(cos_s, n)
-    ok = (ti < np.pi / 2) & (ts < np.pi / 2)
+    # Light crosses only where the refracted ray exists and leaves the plane:
+    # above the horizon, below the critical angle (n < 1), and cos θ' > 0
+    # (which fails in floating point for n -> 1 within ~1e-12 of grazing).
+    ok = (ti < np.pi / 2) & (ts < np.pi / 2) & (cos_ip > 0.0) & (cos_sp > 0.0)
     if n < 1.0:
         ok &= (np.sin(ti) < n) & (np.sin(ts) < n)
     return cos_i, cos_s, cos_ip, cos_sp, (ts_i, tp_i), (ts_s, tp_s), ok
