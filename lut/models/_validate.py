@@ -88,9 +88,16 @@ def azimuth(phi, name: str) -> np.ndarray:
     return arr
 
 
-def angles(theta_i, theta_s, phi_s, names=("theta_i", "theta_s", "phi_s")):
-    """Validate and broadcast the three angle arrays of a BSDF evaluation."""
+def angles(theta_i, theta_s, phi_s, names=("theta_i", "theta_s", "phi_s"), broadcast=True):
+    """Validate the three angle arrays of a BSDF evaluation and broadcast them
+    (or, with ``broadcast=False``, only check that they broadcast)."""
     ti = polar_angle(theta_i, names[0])
     ts = polar_angle(theta_s, names[1])
     ps = azimuth(phi_s, names[2])
-    return np.broadcast_arrays(ti, ts, ps)
+    try:
+        np.broadcast_shapes(ti.shape, ts.shape, ps.shape)
+    except ValueError:
+        raise ValueError(
+            f"{', '.join(names)} must broadcast to one shape, got {ti.shape}, {ts.shape}, {ps.shape}"
+        ) from None
+    return np.broadcast_arrays(ti, ts, ps) if broadcast else (ti, ts, ps)

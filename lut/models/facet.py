@@ -1,30 +1,57 @@
 """Facet (geometric-optics) scattering by the exposed rough interface, in
 reflection and in transmission (paper Sec. 2.4, Eqs. 29-43; SCATMECH's
-``Facet_BRDF_Model``).  No shadowing or obscuration, as in the paper."""
+``Facet_BRDF_Model``).  No shadowing or obscuration, as in the paper.
+
+Both models are evaluated from closed forms in the angles: the facet normal
+and slope (Eqs. 31-35), and the rotation between each ray's global s/p basis
+and the facet's local one.  The local s vector is ∝ k_a × k_b (k_a, k_b the
+two rays), so its components in the two global bases are simple dot products
+(for reflection these are SCATMECH's a2 and a3 terms)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from . import _validate, distributions, fresnel, geometry
-from .geometry import dot
-from .mueller import jones_to_mueller
+from . import _validate, _vectorize, distributions, fresnel, geometry
+
+#: Where |k_a × k_b| is below this the facet is met at normal incidence: its
+#: local s vector is taken as the incoming ray's s (the result does not depend
+#: on the choice there).
+_NORMAL_EPS = 1e-12
 
 
-def _mirror_normal(k_in, k_out):
-    """Facet normal that reflects k_in into k_out: (k_out - k_in)/|k_out - k_in|."""
-    h, norm = geometry.unit_or(k_out - k_in, np.array([0.0, 0.0, 1.0]))
-    return h, norm
+def _basis_azimuth(sin_theta, cos_phi, sin_phi):
+    """cos and sin of the azimuth of the outgoing ray's s/p basis: the ray's
+    own, except s = ŷ (azimuth 0) along the normal (geometry.sp_basis)."""
+    normal = sin_theta < geometry.PARALLEL_EPS
+    return np.where(normal, 1.0, cos_phi), np.where(normal, 0.0, sin_phi)
 
 
-def _slope_density(h, slope, distribution):
-    """P(ζ)/h_z⁴ = P(ζ) sec⁴θn for facet normals h with h_z > 0 (paper Eq. 38
-    times Eq. 29); zero where h_z <= 0."""
-    hz = h[..., 2]
-    up = hz > 0.0
-    hz_safe = np.where(up, hz, 1.0)
-    zeta = np.sqrt(h[..., 0] ** 2 + h[..., 1] ** 2) / hz_safe
-    return np.where(up, distributions.pdf(zeta, slope, distribution) / hz_safe**4, 0.0)
+def _rotations(ua, va, ub, vb, fallback_b):
+    """Normalize the components (ua, va) of the local s vector in the incoming
+    basis and (ub, vb) in the outgoing one; where they vanish use s_loc = s_a,
+    whose outgoing components are ``fallback_b``.  Returns cos α, sin α,
+    cos β, sin β."""
+    norm = np.sqrt(ua * ua + va * va)
+    ok = norm > _NORMAL_EPS
+    inv = 1.0 / np.where(ok, norm, 1.0)
+    fb_c, fb_s = fallback_b
+    fb_norm = 1.0 / np.sqrt(fb_c * fb_c + fb_s * fb_s)
+    return (
+        np.where(ok, ua * inv, 1.0),
+        np.where(ok, va * inv, 0.0),
+        np.where(ok, ub * inv, fb_c * fb_norm),
+        np.where(ok, vb * inv, fb_s * fb_norm),
+    )
+
+
+def _check(n, slope, distribution, name):
+    n = _validate.index(n)
+    slope = _validate.rms_slope(slope)
+    distribution = _validate.distribution(distribution)
+    if slope == 0.0:
+        raise ValueError(f"slope must be > 0 for {name} (slope 0 is a delta: a mirror or a refracted beam)")
+    return n, slope, distribution
 
 
 def facet_reflection(theta_i, theta_s, phi_s, *, n, slope, distribution="gaussian", mueller=True):
@@ -42,30 +69,39 @@ def facet_reflection(theta_i, theta_s, phi_s, *, n, slope, distribution="gaussia
     total RMS slope s (> 0); distribution 'gaussian' | 'exponential'.
     Returns shape broadcast(angles) + (4, 4), or M00 alone (shape of the angles)
     with ``mueller=False``.  Directions at or below the horizon give zero."""
-    n = _validate.index(n)
-    slope = _validate.rms_slope(slope)
-    distribution = _validate.distribution(distribution)
-    ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s)
-    if slope == 0.0:
-        raise ValueError("slope must be > 0 for facet_reflection (slope 0 is a mirror: a delta)")
+    n, slope, distribution = _check(n, slope, distribution, "facet_reflection")
+    angles = _validate.angles(theta_i, theta_s, phi_s, broadcast=False)
 
-    k_i = geometry.incident(ti)
-    k_s = geometry.scattered(ts, ps)
-    h, _ = _mirror_normal(k_i, k_s)
-    cos_iota = np.clip(dot(k_s, h), 0.0, 1.0)
-    cos_ti, cos_ts = np.cos(ti), np.cos(ts)
-    visible = (ti < np.pi / 2) & (ts < np.pi / 2) & (h[..., 2] > 0.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
+    def kernel(ci, si, up_i, cs, ss, up_s, cp, sp, want_mueller):
+        # k_s - k_i = 2 cos ι n̂ (Eq. 35's facet); its transverse part gives the
+        # slope without the cancellation of |k_s - k_i|² - (cos θi + cos θs)².
+        hx, hy = ss * cp - si, ss * sp
+        up = up_i & up_s
+        zsum = np.where(up, ci + cs, 1.0)
+        trans2 = hx * hx + hy * hy
+        cos_iota = np.clip(0.5 * np.sqrt(trans2 + zsum * zsum), 0.0, 1.0)
+        zeta2 = trans2 / (zsum * zsum)
+        sec4 = (1.0 + zeta2) ** 2  # sec⁴θn, Eq. 38
         scale = np.where(
-            visible,
-            _slope_density(h, slope, distribution) / (4.0 * cos_ti * cos_ts),
+            up,
+            distributions.pdf(np.sqrt(zeta2), slope, distribution) * sec4 / (4.0 * np.where(up, ci * cs, 1.0)),
             0.0,
         )
-    rs, rp = fresnel.reflection_coefficients(cos_iota, n)
-    if not mueller:
-        return scale * 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)
-    jones = geometry.interface_jones(k_i, k_s, h, rs, rp, geometry.sp_basis(k_i), geometry.sp_basis(k_s))
-    return scale[..., None, None] * jones_to_mueller(jones)
+        rs, rp = fresnel.reflection_coefficients(cos_iota, n)
+        if not want_mueller:
+            return scale * 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)
+        cpb, spb = _basis_azimuth(ss, cp, sp)
+        # Local s ∝ k_i × k_s; its components in the bases of k_i and k_s.
+        rot = _rotations(
+            -(ci * ss * cpb + si * cs),
+            ss * spb,
+            -(ci * ss + si * cs * cpb),
+            si * spb,
+            (cpb, -cs * spb),
+        )
+        return scale[:, None, None] * _vectorize.rotated_interface_mueller(rs, rp, *rot)
+
+    return _vectorize.evaluate(kernel, angles, mueller)
 
 
 def transmission_normal(k_i, k_t, n):
@@ -92,30 +128,38 @@ def facet_transmission(theta_i, theta_t, phi_t, *, n, slope, distribution="gauss
 
     Parameters and return as for ``facet_reflection``.  At D = 0 (n = 1 in the
     forward direction, where the BTDF is a delta) the value is 0."""
-    n = _validate.index(n)
-    slope = _validate.rms_slope(slope)
-    distribution = _validate.distribution(distribution)
-    ti, tt, pt = _validate.angles(theta_i, theta_t, phi_t, ("theta_i", "theta_t", "phi_t"))
-    if slope == 0.0:
-        raise ValueError("slope must be > 0 for facet_transmission (slope 0 is a delta)")
+    n, slope, distribution = _check(n, slope, distribution, "facet_transmission")
+    angles = _validate.angles(theta_i, theta_t, phi_t, ("theta_i", "theta_t", "phi_t"), broadcast=False)
 
-    k_i = geometry.incident(ti)
-    k_t = geometry.transmitted(tt, pt)
-    h, d = transmission_normal(k_i, k_t, n)
-    cos_ii = -dot(k_i, h)
-    cos_it = -dot(k_t, h)
-    ok = (ti < np.pi / 2) & (tt < np.pi / 2) & (cos_ii >= 0.0) & (cos_it >= 0.0)
-    ok &= (d > geometry.PARALLEL_EPS) & (h[..., 2] > 0.0)
-    cos_ii = np.clip(cos_ii, 0.0, 1.0)
-    ts_, tp_, _ = fresnel.transmission_coefficients(cos_ii, n)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        jac = n * n * cos_it / (d * d)
-        scale = np.where(
-            ok,
-            jac * n * cos_it / (np.cos(tt) * np.cos(ti)) * _slope_density(h, slope, distribution),
-            0.0,
+    def kernel(ci, si, up_i, ct, st, up_t, cp, sp, want_mueller):
+        # v = k_i - n k_t (Eq. 31), D = |v| (Eq. 32), n̂ = ±v/D with n̂_z >= 0.
+        vx, vy, vz = si - n * st * cp, -n * st * sp, n * ct - ci
+        d2 = vx * vx + vy * vy + vz * vz
+        ki_kt = si * st * cp + ci * ct
+        sign = np.where(vz < 0.0, -1.0, 1.0)
+        ok = up_i & up_t & (d2 > geometry.PARALLEL_EPS**2) & (vz != 0.0)
+        d = np.sqrt(np.where(ok, d2, 1.0))
+        cos_ii = -sign * (1.0 - n * ki_kt) / d  # -k_i · n̂ (Eq. 33)
+        cos_it = -sign * (ki_kt - n) / d  # -k_t · n̂ (Eq. 34)
+        ok &= (cos_ii >= 0.0) & (cos_it >= 0.0)
+        vz_ok = np.where(ok, vz, 1.0)
+        zeta2 = (vx * vx + vy * vy) / (vz_ok * vz_ok)
+        sec4 = (1.0 + zeta2) ** 2
+        jac = n * n * cos_it / np.where(ok, d2, 1.0)  # dΩn/dΩt, = Eq. 39
+        density = distributions.pdf(np.sqrt(zeta2), slope, distribution) * sec4
+        scale = np.where(ok, jac * n * cos_it * density / np.where(ok, ct * ci, 1.0), 0.0)
+        t_s, t_p, _ = fresnel.transmission_coefficients(np.clip(cos_ii, 0.0, 1.0), n)
+        if not want_mueller:
+            return scale * 0.5 * (t_s * t_s + t_p * t_p)
+        cpb, spb = _basis_azimuth(st, cp, sp)
+        # Local s ∝ k_i × k_t; its components in the bases of k_i and k_t.
+        rot = _rotations(
+            si * ct - ci * st * cpb,
+            st * spb,
+            si * ct * cpb - ci * st,
+            si * spb,
+            (cpb, ct * spb),
         )
-    if not mueller:
-        return scale * 0.5 * (ts_ * ts_ + tp_ * tp_)
-    jones = geometry.interface_jones(k_i, k_t, h, ts_, tp_, geometry.sp_basis(k_i), geometry.sp_basis(k_t))
-    return scale[..., None, None] * jones_to_mueller(jones)
+        return scale[:, None, None] * _vectorize.rotated_interface_mueller(t_s, t_p, *rot)
+
+    return _vectorize.evaluate(kernel, angles, mueller)

@@ -15,7 +15,8 @@ def henyey_greenstein(cos_theta, g: float):
     definition of g, so we use (1 - 2g cos θ + g²) as SCATMECH's
     ``Henyey_Greenstein_Phase_Function`` does."""
     c = np.asarray(cos_theta, dtype=float)
-    return (1.0 - g * g) / (4.0 * np.pi * (1.0 + g * g - 2.0 * g * c) ** 1.5)
+    d = 1.0 + g * g - 2.0 * g * c
+    return (1.0 - g * g) / (4.0 * np.pi * d * np.sqrt(d))
 
 
 def rayleigh_factor(cos_theta, g: float):

@@ -4,25 +4,23 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _validate, fresnel, geometry, phase
-from .geometry import dot
+from . import _validate, _vectorize, fresnel, geometry, phase
 from .mueller import jones_to_mueller
 
 
-def _refracted_cosines(ti, ts, n):
+def _refracted_cosines(cos_i, sin_i, up_i, cos_s, sin_s, up_s, n):
     """cos θ' inside the binder for the incident and scattered directions
-    (Snell, Eq. 9), and the mask of directions that cross the interface
-    (above the horizon and, for n < 1, below the critical angle)."""
-    cos_i, cos_s = np.cos(ti), np.cos(ts)
+    (Snell, Eq. 9), the air-side transmission coefficients, and the mask of
+    directions that cross the interface."""
     ts_i, tp_i, cos_ip = fresnel.transmission_coefficients(cos_i, n)
     ts_s, tp_s, cos_sp = fresnel.transmission_coefficients(cos_s, n)
     # Light crosses only where the refracted ray exists and leaves the plane:
     # above the horizon, below the critical angle (n < 1), and cos θ' > 0
     # (which fails in floating point for n -> 1 within ~1e-12 of grazing).
-    ok = (ti < np.pi / 2) & (ts < np.pi / 2) & (cos_ip > 0.0) & (cos_sp > 0.0)
+    ok = up_i & up_s & (cos_ip > 0.0) & (cos_sp > 0.0)
     if n < 1.0:
-        ok &= (np.sin(ti) < n) & (np.sin(ts) < n)
-    return cos_i, cos_s, cos_ip, cos_sp, (ts_i, tp_i), (ts_s, tp_s), ok
+        ok &= (sin_i < n) & (sin_s < n)
+    return cos_ip, cos_sp, (ts_i, tp_i), (ts_s, tp_s), ok
 
 
 def smooth_diffuse(theta_i, theta_s, phi_s, *, n, rho, mueller=True):
@@ -41,21 +39,33 @@ def smooth_diffuse(theta_i, theta_s, phi_s, *, n, rho, mueller=True):
     Returns broadcast(angles) + (4, 4), or M00 alone with ``mueller=False``."""
     n = _validate.index(n)
     rho = _validate.reflectance(rho)
-    ti, ts, _ = _validate.angles(theta_i, theta_s, phi_s)
-    cos_i, cos_s, cos_ip, cos_sp, (tis, tip), (trs, trp), ok = _refracted_cosines(ti, ts, n)
-    rbar = fresnel.internal_reflectance(n)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        scale = np.where(ok, rho / np.pi / (1.0 - rho * rbar) * cos_sp * cos_ip / (cos_s * cos_i), 0.0)
-    a_i, b_i = tis * tis + tip * tip, tis * tis - tip * tip
-    a_s, b_s = trs * trs + trp * trp, trs * trs - trp * trp
+    ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s, broadcast=False)
+    factor = rho / np.pi / (1.0 - rho * fresnel.internal_reflectance(n))
+    # Eq. 27 is a product of an entry factor of θi and an exit factor of θs:
+    # evaluate each on its own array and broadcast the product.
+    a_i, b_i = _transmittance_factors(ti, n)
+    a_s, b_s = _transmittance_factors(ts, n)
+    shape = np.broadcast_shapes(ti.shape, ts.shape, ps.shape)
     if not mueller:
-        return scale * 0.25 * a_s * a_i
-    m = np.zeros(scale.shape + (4, 4))
-    m[..., 0, 0] = a_s * a_i
-    m[..., 0, 1] = a_s * b_i
-    m[..., 1, 0] = b_s * a_i
-    m[..., 1, 1] = b_s * b_i
-    return (0.25 * scale)[..., None, None] * m
+        return np.broadcast_to(factor * a_s * a_i, shape).copy()
+    m = np.zeros(shape + (4, 4))
+    m[..., 0, 0] = factor * a_s * a_i
+    m[..., 0, 1] = factor * a_s * b_i
+    m[..., 1, 0] = factor * b_s * a_i
+    m[..., 1, 1] = factor * b_s * b_i
+    return m
+
+
+def _transmittance_factors(theta, n):
+    """Per-direction factors of Eqs. 27-28: cos θ'/cos θ · (|t_s|² ± |t_p|²)/2,
+    zero where no light crosses (at or below the horizon, total reflection)."""
+    cos_t, sin_t = _vectorize.cos_sin_polar(theta)
+    t_s, t_p, cos_in = fresnel.transmission_coefficients(cos_t, n)
+    ok = (theta < np.pi / 2) & (cos_in > 0.0)
+    if n < 1.0:
+        ok &= sin_t < n
+    scale = np.where(ok, cos_in / np.where(ok, cos_t, 1.0), 0.0)
+    return 0.5 * scale * (t_s * t_s + t_p * t_p), 0.5 * scale * (t_s * t_s - t_p * t_p)
 
 
 def smooth_single(theta_i, theta_s, phi_s, *, n, g, mueller=True):
@@ -70,41 +80,41 @@ def smooth_single(theta_i, theta_s, phi_s, *, n, g, mueller=True):
     Jones matrix diag(t_rs, t_rp) · V · diag(t_is, t_ip), V holding the dot
     products of the internal s/p vectors: the projection dyadic of Eq. 4 seen
     in the s/p bases.  This form needs no σ/π basis (Eq. 3), so the forward
-    and backward directions (k1×k2 = 0) are regular.  No absorption: the
-    single-scattering albedo weight is applied by the caller.
+    and backward directions (k1×k2 = 0) are regular.  With p = k×s for every
+    ray, V_pp = sin θ'i sin θ's - cos θ'i cos θ's cos φ: Eq. 13 prints the
+    second term with a + sign, which is the same matrix in a basis whose p
+    vector is reversed on one ray; the s/p convention here is SCATMECH's and
+    matches it element for element.  No absorption.
 
     Parameters: angles in radians; n binder index (> 0); g in (-1, 1).
     Returns broadcast(angles) + (4, 4), or M00 alone with ``mueller=False``."""
     n = _validate.index(n)
     g = _validate.asymmetry(g)
-    ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s)
-    cos_i, cos_s, cos_ip, cos_sp, (tis, tip), (trs, trp), ok = _refracted_cosines(ti, ts, n)
-    # Internal propagation directions (Eq. 9) and their s/p bases.
-    si, ss = np.sin(ti) / n, np.sin(ts) / n
-    k1 = geometry.vec(si, 0.0, -cos_ip)
-    k2 = geometry.vec(ss * np.cos(ps), ss * np.sin(ps), cos_sp)
-    s1, p1 = geometry.sp_basis(k1)
-    s2, p2 = geometry.sp_basis(k2)
-    cos_sc = np.clip(dot(k1, k2), -1.0, 1.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        scale = np.where(
-            ok,
-            phase.rayleigh_factor(cos_sc, g) * cos_ip * cos_sp / (cos_i * cos_s * (cos_ip + cos_sp)),
-            0.0,
-        )
-    v_ss, v_sp = dot(s2, s1), dot(s2, p1)
-    v_ps, v_pp = dot(p2, s1), dot(p2, p1)
-    if not mueller:
-        m00 = 0.5 * (
-            trs * trs * (v_ss * v_ss * tis * tis + v_sp * v_sp * tip * tip)
-            + trp * trp * (v_ps * v_ps * tis * tis + v_pp * v_pp * tip * tip)
-        )
-        return scale * m00
-    jones = np.stack(
-        (
-            np.stack((trs * v_ss * tis, trs * v_sp * tip), -1),
-            np.stack((trp * v_ps * tis, trp * v_pp * tip), -1),
-        ),
-        -2,
-    )
-    return scale[..., None, None] * jones_to_mueller(jones)
+    angles = _validate.angles(theta_i, theta_s, phi_s, broadcast=False)
+
+    def kernel(cos_i, sin_i, up_i, cos_s, sin_s, up_s, cp, sp, want_mueller):
+        cos_ip, cos_sp, (tis, tip), (trs, trp), ok = _refracted_cosines(cos_i, sin_i, up_i, cos_s, sin_s, up_s, n)
+        sin_ip, sin_sp = sin_i / n, sin_s / n
+        # Internal rays k1 = (sin θ'i, 0, -cos θ'i), k2 = (sin θ's cos φ, sin θ's sin φ, cos θ's).
+        cos_sc = np.clip(sin_ip * sin_sp * cp - cos_ip * cos_sp, -1.0, 1.0)
+        denom = np.where(ok, cos_i * cos_s * (cos_ip + cos_sp), 1.0)
+        scale = np.where(ok, phase.rayleigh_factor(cos_sc, g) * cos_ip * cos_sp / denom, 0.0)
+        # V in the internal s/p bases (s = ŷ for the exit ray along the normal).
+        normal = sin_sp < geometry.PARALLEL_EPS
+        cb, sb = np.where(normal, 1.0, cp), np.where(normal, 0.0, sp)
+        v_ss, v_sp = cb, -sb * cos_ip
+        v_ps, v_pp = -sb * cos_sp, sin_ip * sin_sp - cos_ip * cos_sp * cb
+        if not want_mueller:
+            tis2, tip2 = tis * tis, tip * tip
+            m00 = trs * trs * (v_ss * v_ss * tis2 + v_sp * v_sp * tip2) + trp * trp * (
+                v_ps * v_ps * tis2 + v_pp * v_pp * tip2
+            )
+            return 0.5 * scale * m00
+        jones = np.empty(scale.shape + (2, 2))
+        jones[:, 0, 0] = trs * v_ss * tis
+        jones[:, 0, 1] = trs * v_sp * tip
+        jones[:, 1, 0] = trp * v_ps * tis
+        jones[:, 1, 1] = trp * v_pp * tip
+        return scale[:, None, None] * jones_to_mueller(jones)
+
+    return _vectorize.evaluate(kernel, angles, mueller)

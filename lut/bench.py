@@ -1,0 +1,131 @@
+"""Measurements behind scripts/benchmark_models.py: model throughput, and run
+time against error for the rough models (numpy only)."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from . import models
+
+CLOSED_FORM = {
+    "facet_reflection": (models.facet_reflection, {"n": 1.5, "slope": 0.3}),
+    "facet_transmission": (models.facet_transmission, {"n": 1.5, "slope": 0.3}),
+    "smooth_diffuse": (models.smooth_diffuse, {"n": 1.5, "rho": 0.93}),
+    "smooth_single": (models.smooth_single, {"n": 1.5, "g": 0.3}),
+}
+
+#: The benchmark paints for the rough models: satin and matte (the paper's CARC).
+ROUGH_PAINTS = {
+    "satin (gaussian, slope 0.25)": {"n": 1.5, "slope": 0.25, "distribution": "gaussian"},
+    "matte (exponential, slope 2)": {"n": 1.5, "slope": 2.0, "distribution": "exponential"},
+}
+
+
+def best_time(repeat, fn, *args, **kwargs):
+    """Shortest wall time of ``repeat`` calls of fn(*args, **kwargs), and the
+    last result."""
+    best, out = np.inf, None
+    for _ in range(repeat):
+        start = time.perf_counter()
+        out = fn(*args, **kwargs)
+        best = min(best, time.perf_counter() - start)
+    return best, out
+
+
+MAX_THETA = np.radians(85.0)
+
+
+def random_angles(count, seed=0, max_theta=MAX_THETA):
+    rng = np.random.default_rng(seed)
+    return rng.uniform(0, max_theta, count), rng.uniform(0, max_theta, count), rng.uniform(-np.pi, np.pi, count)
+
+
+def throughput(count=100_000):
+    """Seconds per evaluation of each closed-form model on ``count`` random
+    angles: full Mueller and M00 alone."""
+    ti, ts, ps = random_angles(count)
+    rows = {}
+    for name, (fn, kw) in CLOSED_FORM.items():
+        t_full, _ = best_time(3, fn, ti, ts, ps, **kw)
+        t_m00, _ = best_time(3, fn, ti, ts, ps, mueller=False, **kw)
+        rows[name] = {"full": t_full / count, "m00": t_m00 / count}
+    return rows
+
+
+def table_angles(shape=(64, 64, 32)):
+    """The (θi, θs, φs) table of the issue: midpoints in θ ∈ [0, π/2), φ ∈ [0, π]."""
+    ti = (np.arange(shape[0]) + 0.5) / shape[0] * np.pi / 2
+    ts = (np.arange(shape[1]) + 0.5) / shape[1] * np.pi / 2
+    ps = np.linspace(0.0, np.pi, shape[2])
+    return np.meshgrid(ti, ts, ps, indexing="ij")
+
+
+def relative_rms(a, b):
+    return float(np.sqrt(np.mean((a - b) ** 2) / np.mean(b**2)))
+
+
+def rough_time_vs_error(
+    shape=(64, 64, 32),
+    single_nodes=((2, 4), (3, 4), (4, 6), (6, 8)),
+    diffuse_nodes=((4, 8), (8, 8), (16, 16)),
+    mc_pairs=(100, 1000, 10000),
+    sample=1500,
+    seed=1,
+):
+    """Time to fill the (θi, θs, φs) table with M00 of each rough model against
+    its relative RMS error, measured on a random subsample of the table
+    against a converged quadrature; and the paper's random-pairs method,
+    timed on the subsample and scaled to the table."""
+    ti, ts, ps = table_angles(shape)
+    size = ti.size
+    pick = np.random.default_rng(seed).choice(size, sample, replace=False)
+    si, ss, sp = ti.ravel()[pick], ts.ravel()[pick], ps.ravel()[pick]
+    report = {}
+    for paint, kw in ROUGH_PAINTS.items():
+        rows = []
+        ref = models.rough_single(si, ss, sp, g=0.3, mueller=False, nodes=(12, 16), **kw)
+        for nodes in single_nodes:
+            t, table = best_time(1, models.rough_single, ti, ts, ps, g=0.3, mueller=False, nodes=nodes, **kw)
+            err = relative_rms(table.ravel()[pick], ref)
+            rows.append({"model": "rough_single", "method": f"quadrature {nodes}", "seconds": t, "rms_error": err})
+        for pairs in mc_pairs:
+            t, got = best_time(1, models.rough_single_random, si, ss, sp, g=0.3, pairs=pairs, seed=seed, **kw)
+            rows.append(
+                {
+                    "model": "rough_single",
+                    "method": f"random pairs {pairs}",
+                    "seconds": t * size / sample,
+                    "rms_error": relative_rms(got, ref),
+                }
+            )
+        ref_d = models.rough_diffuse(si, ss, sp, rho=0.8, mueller=False, nodes=(48, 48), **kw)
+        for nodes in diffuse_nodes:
+            models.rough_internal_reflectance.cache_clear()
+            t, table = best_time(1, models.rough_diffuse, ti, ts, ps, rho=0.8, mueller=False, nodes=nodes, **kw)
+            rows.append(
+                {
+                    "model": "rough_diffuse",
+                    "method": f"quadrature {nodes}",
+                    "seconds": t,
+                    "rms_error": relative_rms(table.ravel()[pick], ref_d),
+                }
+            )
+        report[paint] = rows
+    return report
+
+
+def speedup_at_equal_error(rows, target_method):
+    """How much faster the quadrature ``target_method`` is than the random
+    pairs method at the same error, using MC error ∝ 1/sqrt(pairs) and time ∝
+    pairs fitted to the measured random-pairs rows."""
+    target = next(r for r in rows if r["method"] == target_method)
+    mc = [r for r in rows if r["method"].startswith("random pairs")]
+    pairs = np.array([float(r["method"].split()[-1]) for r in mc])
+    err = np.array([r["rms_error"] for r in mc])
+    secs = np.array([r["seconds"] for r in mc])
+    c_err = np.exp(np.mean(np.log(err * np.sqrt(pairs))))  # err = c / sqrt(N)
+    c_time = secs[-1] / pairs[-1]  # time per pair, from the largest run
+    needed = (c_err / target["rms_error"]) ** 2
+    return needed * c_time / target["seconds"], needed
