@@ -42,10 +42,18 @@ def random_angles(count, seed=0, max_theta=MAX_THETA):
     return rng.uniform(0, max_theta, count), rng.uniform(0, max_theta, count), rng.uniform(-np.pi, np.pi, count)
 
 
-def throughput(count=100_000):
+def throughput(count=100_000, grid=False):
     """Seconds per evaluation of each closed-form model on ``count`` random
-    angles: full Mueller and M00 alone."""
-    ti, ts, ps = random_angles(count)
+    angles, or with ``grid`` on a (θi, θs, φs) grid of about that size passed
+    as broadcastable axes (how LUTs are baked): full Mueller and M00 alone."""
+    if grid:
+        side = round((count / 2) ** (1 / 3))
+        ti = np.linspace(0.0, MAX_THETA, side)[:, None, None]
+        ts = np.linspace(0.0, MAX_THETA, side)[None, :, None]
+        ps = np.linspace(0.0, np.pi, 2 * side)[None, None, :]
+        count = side * side * 2 * side
+    else:
+        ti, ts, ps = random_angles(count)
     rows = {}
     for name, (fn, kw) in CLOSED_FORM.items():
         t_full, _ = best_time(3, fn, ti, ts, ps, **kw)

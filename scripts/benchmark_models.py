@@ -28,11 +28,15 @@ def main(argv=None):
     scatmech = json.loads(BASELINE.read_text())["microseconds_per_evaluation"]
 
     count = 20_000 if args.quick else 100_000
-    print(f"Closed-form models on {count} random angles (best of 3)")
-    print(f"{'model':20} {'SCATMECH us':>12} {'full us':>9} {'M00 us':>8} {'full x':>8} {'M00/full':>9}")
-    for name, row in bench.throughput(count).items():
-        full, m00 = row["full"] * 1e6, row["m00"] * 1e6
-        print(f"{name:20} {scatmech[name]:12.2f} {full:9.3f} {m00:8.3f} {scatmech[name] / full:8.0f} {full / m00:9.1f}")
+    for grid in (False, True):
+        what = "a grid of about" if grid else "random"
+        print(f"Closed-form models on {what} {count} angles (best of 3; time per evaluation)")
+        print(f"{'model':20} {'SCATMECH us':>12} {'full us':>9} {'M00 us':>8} {'vs SCATMECH':>12} {'full/M00':>9}")
+        for name, row in bench.throughput(count, grid=grid).items():
+            full, m00 = row["full"] * 1e6, row["m00"] * 1e6
+            ratio = scatmech[name] / full
+            print(f"{name:20} {scatmech[name]:12.2f} {full:9.3f} {m00:8.3f} {ratio:11.0f}x {full / m00:9.1f}")
+        print()
 
     shape = (32, 32, 16) if args.quick else (64, 64, 32)
     print(f"\nRough models: a {shape[0]}x{shape[1]}x{shape[2]} (theta_i, theta_s, phi_s) table of M00")

@@ -238,3 +238,13 @@ def test_random_pairs_method_agrees_with_the_quadrature():
     ref = models.rough_single(TI[:40], TS[:40], PS[:40], mueller=False, nodes=(12, 16), **kw)
     mc = models.rough_single_random(TI[:40], TS[:40], PS[:40], pairs=4000, seed=3, **kw)
     assert relative_rms(mc, ref) < 0.01
+
+
+def test_example_reproduces_fig2_statements():
+    from lut import examples
+
+    data = examples.fig2_glossy_white()
+    polarized = data["p"] > 1e-12
+    np.testing.assert_allclose(np.abs(data["eta"][polarized]), np.pi / 2, atol=1e-12)
+    assert np.all(np.isnan(data["eta"][~polarized]))
+    assert np.all(data["fr"] > 0) and data["fr"][0] < 0.5 * data["fr"].max()

@@ -66,7 +66,8 @@ def polarization_parameters(mueller: np.ndarray, stokes_in=STOKES_45) -> dict:
               measured from s counter-clockwise looking into the beam [rad],
       ``pc``  degree of circular polarization V/I,
       ``p``   degree of polarization sqrt(Q² + U² + V²)/I.
-    Where the scattered intensity is zero, eta, pc and p are NaN."""
+    Where the scattered intensity is zero, eta, pc and p are NaN; where the
+    light has no linear polarization (Q = U = 0), eta is NaN."""
     m = np.asarray(mueller, dtype=float)
     s_in = np.asarray(stokes_in, dtype=float)
     if s_in.shape != (4,) or s_in[0] <= 0 or np.sum(s_in[1:] ** 2) > s_in[0] ** 2 * (1 + 1e-12):
@@ -78,7 +79,7 @@ def polarization_parameters(mueller: np.ndarray, stokes_in=STOKES_45) -> dict:
     nan = np.nan
     return {
         "fr": m[..., 0, 0],
-        "eta": np.where(lit, 0.5 * np.arctan2(u, q), nan),
+        "eta": np.where(lit & ((q != 0) | (u != 0)), 0.5 * np.arctan2(u, q), nan),
         "pc": np.where(lit, v / safe, nan),
         "p": np.where(lit, np.sqrt(q * q + u * u + v * v) / safe, nan),
     }

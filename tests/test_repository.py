@@ -1,0 +1,23 @@
+"""The README's two set-up commands exist and CI runs them."""
+
+import pathlib
+import re
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+
+def _readme_commands():
+    readme = (ROOT / "README.md").read_text()
+    return re.findall(r"^(bash scripts/bootstrap\.sh && .+)$", readme, flags=re.M)
+
+
+def test_readme_has_an_example_command_and_a_test_command():
+    commands = _readme_commands()
+    assert any("-m lut example" in c for c in commands)
+    assert any("-m pytest" in c for c in commands)
+
+
+def test_ci_runs_the_readme_commands():
+    ci = (ROOT / ".ci" / "run").read_text()
+    for command in _readme_commands():
+        assert command in ci, f"CI does not run the README command: {command}"
