@@ -117,34 +117,28 @@ def visible_normals(theta, slope: float, distribution: str, nodes):
     return h, w
 
 
-def _entry_states(theta_i, n, slope, distribution, nodes):
-    """Rays entering the binder through the visible facets, for incident
-    directions k_i (source at azimuth π).  Returns a dict of arrays (..., M)."""
-    h, w = visible_normals(theta_i, slope, distribution, nodes)
-    h = h * np.array([-1.0, 1.0, 1.0])  # the source sits at azimuth π
-    k = geometry.incident(theta_i)[..., None, :]
-    cos_i = np.clip(-dot(k, h), 0.0, 1.0)
-    k_in, cos_t, ok = geometry.refract(k, h, n, cos_i)
-    t_s, t_p, _ = fresnel.transmission_coefficients(cos_i, n)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        beam = np.where(ok & (cos_i > 0.0), n * cos_t / np.where(cos_i > 0, cos_i, 1.0), 0.0)
-    return {"h": h, "w": w, "k": np.broadcast_to(k, h.shape), "k_in": k_in, "t_s": t_s, "t_p": t_p, "beam": beam}
+def _facet_states(theta, n, slope, distribution, nodes, entering):
+    """Rays crossing the interface through the facets visible from a
+    direction at polar angle θ: entering the binder from the source
+    (k_i, azimuth π) or, with ``entering=False``, leaving it towards the
+    viewer (k_s at azimuth 0; rotate for other azimuths).
 
-
-def _exit_states(theta_s, n, slope, distribution, nodes):
-    """Rays leaving the binder through the visible facets towards
-    k_s = (sin θs, 0, cos θs) (azimuth 0; rotate for other azimuths).  By
-    reciprocity the exit is the entry of the reversed ray -k_s: the internal
-    ray is k_in = -refract(-k_s), and the coefficients are the air-side ones
-    (paper Eqs. 11, 25)."""
-    h, w = visible_normals(theta_s, slope, distribution, nodes)
-    k = geometry.scattered(theta_s, 0.0)[..., None, :]
-    cos_i = np.clip(dot(k, h), 0.0, 1.0)
-    k_rev, cos_t, ok = geometry.refract(-k, h, n, cos_i)
+    By reciprocity the exit is the entry of the reversed ray: the internal ray
+    is minus the refraction of -k_s, and the coefficients are the air-side
+    ones (paper Eqs. 11, 25).  Returns a dict of arrays (..., M): the facet
+    normal h, its weight w, the external propagation direction k, the internal
+    one k_in, t_s, t_p, and the beam factor n cos ι'/cos ι."""
+    h, w = visible_normals(theta, slope, distribution, nodes)
+    u = geometry.scattered(theta, 0.0)[..., None, :]  # towards the viewer or the source
+    if entering:
+        mirror = np.array([-1.0, 1.0, 1.0])  # the source sits at azimuth π
+        h, u = h * mirror, u * mirror
+    cos_i = np.clip(dot(u, h), 0.0, 1.0)
+    k_down, cos_t, ok = geometry.refract(-u, h, n, cos_i)
     t_s, t_p, _ = fresnel.transmission_coefficients(cos_i, n)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        beam = np.where(ok & (cos_i > 0.0), n * cos_t / np.where(cos_i > 0, cos_i, 1.0), 0.0)
-    return {"h": h, "w": w, "k": np.broadcast_to(k, h.shape), "k_in": -k_rev, "t_s": t_s, "t_p": t_p, "beam": beam}
+    beam = np.where(ok & (cos_i > 0.0), n * cos_t / np.where(cos_i > 0, cos_i, 1.0), 0.0)
+    k = np.broadcast_to(-u if entering else u, h.shape)
+    return {"h": h, "w": w, "k": k, "k_in": k_down if entering else -k_down, "t_s": t_s, "t_p": t_p, "beam": beam}
 
 
 # --------------------------------------------------------------------------- diffuse
@@ -153,7 +147,7 @@ def _exit_states(theta_s, n, slope, distribution, nodes):
 def _transmittance_rows(theta, n, slope, distribution, nodes):
     """Facet-averaged first row of the entry transmittance Mueller matrix
     (= first column of the exit one), shape (..., 4)."""
-    st = _entry_states(theta, n, slope, distribution, nodes)
+    st = _facet_states(theta, n, slope, distribution, nodes, entering=True)
     basis_a = geometry.sp_basis(st["k"])
     basis_b = geometry.sp_basis(st["k_in"])
     jones = geometry.interface_jones(st["k"], st["k_in"], st["h"], st["t_s"], st["t_p"], basis_a, basis_b)
@@ -272,42 +266,28 @@ def rough_single(theta_i, theta_s, phi_s, *, n, g, slope, distribution="gaussian
     return _single_sum(ti, ts, ps, n, g, slope, distribution, nodes, nodes, mueller)
 
 
-def _prepare_entry(theta, n, slope, distribution, nodes):
-    st = _entry_states(theta, n, slope, distribution, nodes)
+def _prepare(theta, n, slope, distribution, nodes, entering):
+    """Facet states for the single-scatter sum: weights (zero for rays that
+    do not head into, respectively out of, the bulk), depths |cos θ'|, the
+    internal local s/p vectors, and the Jones matrix of the crossing between
+    the ray's global s/p basis and the facet's internal one: A = diag(t_s,
+    t_p)·R on entry; on exit its transpose, B = Rᵀ·diag(t_s, t_p)."""
+    st = _facet_states(theta, n, slope, distribution, nodes, entering)
     s_loc, p_ext, p_int = _local_basis(st["k"], st["k_in"], st["h"])
-    down = st["k_in"][..., 2] < 0.0
-    st["weight"] = np.where(down, st["w"] * st["beam"], 0.0)
+    heading = st["k_in"][..., 2] < 0.0 if entering else st["k_in"][..., 2] > 0.0
+    st["weight"] = np.where(heading, st["w"] * st["beam"], 0.0)
     st["depth"] = np.abs(st["k_in"][..., 2])
     st["s"], st["p"] = s_loc, p_int
-    s_a, p_a = geometry.sp_basis(st["k"])
-    # A = diag(t_s, t_p) · R_in, global s/p of k_i -> local s/p inside.
-    st["A"] = np.stack(
+    s_g, p_g = geometry.sp_basis(st["k"])
+    jones = np.stack(
         (
-            np.stack((st["t_s"] * dot(s_loc, s_a), st["t_s"] * dot(s_loc, p_a)), -1),
-            np.stack((st["t_p"] * dot(p_ext, s_a), st["t_p"] * dot(p_ext, p_a)), -1),
+            np.stack((st["t_s"] * dot(s_loc, s_g), st["t_s"] * dot(s_loc, p_g)), -1),
+            np.stack((st["t_p"] * dot(p_ext, s_g), st["t_p"] * dot(p_ext, p_g)), -1),
         ),
         -2,
     )
-    return st
-
-
-def _prepare_exit(theta, n, slope, distribution, nodes):
-    st = _exit_states(theta, n, slope, distribution, nodes)
-    s_loc, p_ext, p_int = _local_basis(st["k"], st["k_in"], st["h"])
-    up = st["k_in"][..., 2] > 0.0
-    st["weight"] = np.where(up, st["w"] * st["beam"], 0.0)
-    st["depth"] = np.abs(st["k_in"][..., 2])
-    st["s"], st["p"] = s_loc, p_int
-    s_b, p_b = geometry.sp_basis(st["k"])
-    # B = R_out · diag(t_s, t_p), local s/p inside -> global s/p of k_s.  The
-    # global basis at φs = 0 rotates rigidly with the azimuth (for θs > 0).
-    st["B"] = np.stack(
-        (
-            np.stack((dot(s_b, s_loc) * st["t_s"], dot(s_b, p_ext) * st["t_p"]), -1),
-            np.stack((dot(p_b, s_loc) * st["t_s"], dot(p_b, p_ext) * st["t_p"]), -1),
-        ),
-        -2,
-    )
+    # At φs = 0 the exit's global basis turns rigidly with the azimuth (θs > 0).
+    st["J"] = jones if entering else np.swapaxes(jones, -1, -2)
     return st
 
 
@@ -316,8 +296,8 @@ def _single_sum(ti, ts, ps, n, g, slope, distribution, nodes_in, nodes_out, muel
     ti, ts, ps = ti.ravel(), ts.ravel(), ps.ravel()
     ui, inv_i = np.unique(ti, return_inverse=True)
     us, inv_s = np.unique(ts, return_inverse=True)
-    entry = _prepare_entry(ui, n, slope, distribution, nodes_in)
-    exit_ = _prepare_exit(us, n, slope, distribution, nodes_out)
+    entry = _prepare(ui, n, slope, distribution, nodes_in, entering=True)
+    exit_ = _prepare(us, n, slope, distribution, nodes_out, entering=False)
     m_in, m_out = entry["w"].shape[-1], exit_["w"].shape[-1]
     lit = (ti < np.pi / 2) & (ts < np.pi / 2)
     # At θs = 0 the global s/p basis of k_s is ŷ/-x̂ whatever φs: do not rotate it.
@@ -351,7 +331,7 @@ def _single_sum(ti, ts, ps, n, g, slope, distribution, nodes_in, nodes_out, muel
             out[sl] = np.sum(weight * m00, axis=(1, 2))
             continue
         v = np.stack((np.stack((v_ss, v_sp), -1), np.stack((v_ps, v_pp), -1)), -2)
-        bmat = b["B"]
+        bmat = b["J"]
         # Rotating the exit states by φs leaves B unchanged except at θs = 0,
         # where the global basis stays fixed while the local one turns.
         rot = ~basis_rot[sl]
@@ -362,7 +342,7 @@ def _single_sum(ti, ts, ps, n, g, slope, distribution, nodes_in, nodes_out, muel
             )  # (c, 1, 2, 2): rotation of the s/p components by -φs
             bmat = bmat.copy()
             bmat[rot] = np.matmul(r, bmat[rot])
-        jones = np.matmul(np.matmul(bmat[:, None, :, :, :], v), a["A"][:, :, None, :, :])
+        jones = np.matmul(np.matmul(bmat[:, None, :, :, :], v), a["J"][:, :, None, :, :])
         out[sl] = np.sum(weight[..., None, None] * jones_to_mueller(jones), axis=(1, 2))
     out[~lit] = 0.0
     return out.reshape(shape + ((4, 4) if mueller else ()))
