@@ -1,0 +1,150 @@
+"""Paint LUT files: OpenEXR images written and read with OpenImageIO.
+
+Layout (format version 1).  A float32 RGB image of width N_u and height
+N_φd · N_θd: pixel (x, y) holds G = f · cos θi · cos θs (``lut.table``) at
+u = x / (N_u - 1), θd = (y mod N_θd) / (N_θd - 1) · π/2 and
+φd = (y div N_θd) / (N_φd - 1) · π/2, i.e. N_φd tiles of (θh, θd) stacked
+vertically.  The values are data, not colour: read them as Non-Color.
+
+Header attributes:
+  paintlut:format  the format version (int)
+  paintlut:meta    JSON: paint, working space, parameterization, resolution,
+                   quadrature sizes, model version
+  paintlut:key     SHA-256 of the canonical meta JSON: the cache key
+  paintlut:hash    SHA-256 of the meta JSON and the pixel bytes: detects a
+                   file whose content was altered
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import os
+import pathlib
+import tempfile
+
+import numpy as np
+
+FORMAT_VERSION = 1
+PARAMETERIZATION = "rusinkiewicz(theta_h=pi/2*u^2, theta_d, phi_d in [0, pi/2]); G = f cos(theta_i) cos(theta_s)"
+
+
+class LUTError(ValueError):
+    """A LUT file that cannot be used: missing, unreadable or truncated, of
+    another format version, or whose content does not match its hash."""
+
+
+def _oiio():
+    try:
+        import OpenImageIO as oiio
+    except ImportError:  # Blender's bundled module, exposed by bpy
+        import bpy  # noqa: F401
+
+        bpy.utils.expose_bundled_modules()
+        import OpenImageIO as oiio
+    return oiio
+
+
+def canonical_json(meta: dict) -> str:
+    return json.dumps(meta, sort_keys=True, separators=(",", ":"))
+
+
+def cache_key(meta: dict) -> str:
+    return hashlib.sha256(canonical_json(meta).encode()).hexdigest()
+
+
+def content_hash(meta_json: str, pixels: np.ndarray) -> str:
+    h = hashlib.sha256(meta_json.encode())
+    h.update(np.ascontiguousarray(pixels, dtype="<f4").tobytes())
+    return h.hexdigest()
+
+
+def _to_image(table: np.ndarray) -> np.ndarray:
+    n_p, n_d, n_u, c = table.shape
+    return np.ascontiguousarray(table.reshape(n_p * n_d, n_u, c), dtype=np.float32)
+
+
+def write(path, table: np.ndarray, meta: dict) -> pathlib.Path:
+    """Write a table (N_φd, N_θd, N_u, 3) and its meta atomically: to a
+    temporary file in the same directory, renamed into place, so an
+    interrupted write never leaves a partial file under ``path``."""
+    oiio = _oiio()
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    image = _to_image(table)
+    meta_json = canonical_json(meta)
+    spec = oiio.ImageSpec(image.shape[1], image.shape[0], image.shape[2], oiio.FLOAT)
+    spec.channelnames = ("R", "G", "B")
+    spec.attribute("compression", "zip")
+    spec.attribute("oiio:ColorSpace", "Non-Color")
+    spec.attribute("paintlut:format", FORMAT_VERSION)
+    spec.attribute("paintlut:meta", meta_json)
+    spec.attribute("paintlut:key", cache_key(meta))
+    spec.attribute("paintlut:hash", content_hash(meta_json, image))
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".partial.exr")
+    os.close(fd)
+    try:
+        out = oiio.ImageOutput.create(tmp)
+        if out is None or not out.open(tmp, spec):
+            raise OSError(f"cannot write {tmp}: {oiio.geterror()}")
+        ok = out.write_image(image)
+        out.close()
+        if not ok:
+            raise OSError(f"cannot write {tmp}: {oiio.geterror()}")
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            os.remove(tmp)
+    return path
+
+
+def read_header(path) -> dict:
+    """The meta of a LUT file (checks the format version, not the pixels)."""
+    oiio = _oiio()
+    path = pathlib.Path(path)
+    if not path.is_file():
+        raise LUTError(f"{path}: no such LUT file")
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise LUTError(f"{path}: not a readable EXR image (truncated or corrupt?): {oiio.geterror()}")
+    try:
+        spec = inp.spec()
+        version = spec.getattribute("paintlut:format")
+        if version is None:
+            raise LUTError(f"{path}: not a Paint LUT (no paintlut:format attribute)")
+        if int(version) != FORMAT_VERSION:
+            raise LUTError(f"{path}: LUT format version {version}; this version of Paint LUT reads {FORMAT_VERSION}")
+        meta_json = spec.getattribute("paintlut:meta")
+        return {
+            "meta": json.loads(meta_json),
+            "meta_json": meta_json,
+            "key": spec.getattribute("paintlut:key"),
+            "hash": spec.getattribute("paintlut:hash"),
+            "size": (spec.width, spec.height, spec.nchannels),
+        }
+    finally:
+        inp.close()
+
+
+def read(path):
+    """(table, meta) of a LUT file, verified against its content hash."""
+    oiio = _oiio()
+    header = read_header(path)
+    inp = oiio.ImageInput.open(str(path))
+    try:
+        pixels = inp.read_image(oiio.FLOAT)
+    finally:
+        inp.close()
+    if pixels is None or np.ndim(pixels) != 3:
+        raise LUTError(f"{path}: pixel data cannot be read (truncated file?): {oiio.geterror()}")
+    meta = header["meta"]
+    if header["key"] != cache_key(meta):
+        raise LUTError(f"{path}: header key does not match its meta (altered file)")
+    if header["hash"] != content_hash(header["meta_json"], pixels):
+        raise LUTError(f"{path}: content does not match its hash (altered or damaged file)")
+    n_u, n_d, n_p = meta["resolution"]
+    if pixels.shape != (n_p * n_d, n_u, 3):
+        raise LUTError(f"{path}: image size {pixels.shape} does not match resolution {meta['resolution']}")
+    return np.asarray(pixels, dtype=np.float32).reshape(n_p, n_d, n_u, 3), meta

@@ -1,0 +1,317 @@
+"""One paint: the paper's incoherent combination of its models (Sec. 4).
+
+    f = facet · f_facet + single · f_single + f_diffuse(ρ)
+
+f_facet is the facet reflection of the exposed interface (Sec. 2.4; under a
+smooth interface a mirror, i.e. a delta, exposed by
+``Paint.specular_reflectance``), f_single the single volume scattering (Eq. 20
+or its rough counterpart) with weight ``single``, and f_diffuse the totally
+diffuse term (Eq. 27 or its rough counterpart) of substrate reflectance ρ.
+
+Colour.  ``rho`` and ``single`` are RGB triples in the paint's working space
+``space``, or spectra (``lut.colour_management.Spectrum``).  The diffuse term
+is non-linear in ρ, f_diffuse(ρ) = ρ(1 - r̄)/(1 - ρ r̄) · f_diffuse(1) (Eq. 27,
+and the same factor under a rough interface with its r̄), so an RGB paint
+applies that factor per channel, and a spectral paint per wavelength before
+integrating to RGB (CIE 1931 2°, D65).  Every other dependence on colour is
+linear, so with a non-dispersive n the spectral integral is exact at the cost
+of one evaluation of each term's geometry.  A dispersive n (Cauchy
+coefficients, spectral paints only) evaluates the geometry per band.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+
+from . import colour_management as cm
+from . import models
+from .models import _validate, fresnel
+from .models.rough import DIFFUSE_NODES, SINGLE_NODES
+
+#: Band edges [nm] for a dispersive index: the geometry is evaluated at each
+#: band's centre wavelength.
+DISPERSION_BANDS = np.linspace(380.0, 780.0, 9)
+
+
+def _colour_value(value, name: str):
+    """An RGB triple (or a grey scalar) in [0, 1], or a Spectrum (given as
+    one, as a dataset name or .csv path, or as a dict; see Paint.from_dict)."""
+    if isinstance(value, (str, dict)):
+        value = _colour_from_json(value, name)
+    if isinstance(value, cm.Spectrum):
+        if np.any(value.values < 0) or np.any(value.values > 1):
+            raise ValueError(f"{name} spectrum must lie in [0, 1] at every wavelength")
+        return value
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        value = (value, value, value)
+    try:
+        triple = tuple(float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be an RGB triple of numbers in [0, 1], a grey number or a Spectrum") from None
+    if len(triple) != 3:
+        raise ValueError(f"{name} must be an RGB triple of numbers in [0, 1], got {len(triple)} values")
+    for v in triple:
+        _validate.reflectance(v, name)
+    return triple
+
+
+def _index(value):
+    """n: a number > 0, or Cauchy coefficients (A, B[, C...]) giving
+    n(λ) = A + B/λ² + C/λ⁴ + ... with λ in µm."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return _validate.index(value)
+    try:
+        coeffs = tuple(float(c) for c in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"n must be a number > 0 or Cauchy coefficients (A, B, ...), got {value!r}") from None
+    if not 1 <= len(coeffs) <= 4 or not all(math.isfinite(c) for c in coeffs):
+        raise ValueError("n as Cauchy coefficients must be 1 to 4 finite numbers (A, B, C, D), lambda in um")
+    for wl in (0.38, 0.78):
+        _validate.index(_cauchy(coeffs, wl))
+    return coeffs if len(coeffs) > 1 else coeffs[0]
+
+
+def _cauchy(coeffs, wavelength_um):
+    return sum(c / wavelength_um ** (2 * k) for k, c in enumerate(coeffs))
+
+
+@dataclasses.dataclass(frozen=True)
+class Paint:
+    """A paint (paper Sec. 4).  All fields are keywords; see the module
+    docstring for how they combine.
+
+    n             binder index (> 0), or Cauchy coefficients for a spectral paint
+    rho           diffuse subsurface reflectance: RGB triple, grey number or Spectrum, in [0, 1]
+    single        weight of the single-scatter term: RGB, grey or Spectrum (default 0)
+    g             Henyey-Greenstein asymmetry, -1 < g < 1 (default 0)
+    slope         total RMS slope of the interface, >= 0 (0: smooth; default 0)
+    distribution  'gaussian' or 'exponential' slope distribution
+    facet         weight of the facet (interface) reflection, >= 0 (default 1)
+    space         working space of RGB values and of the results
+    name          a label (not part of the physics)
+    """
+
+    n: Any = 1.5
+    rho: Any = (0.8, 0.8, 0.8)
+    single: Any = 0.0
+    g: float = 0.0
+    slope: float = 0.0
+    distribution: str = "gaussian"
+    facet: float = 1.0
+    space: str = cm.DEFAULT_SPACE
+    name: str = ""
+
+    def __post_init__(self):
+        setattr_ = object.__setattr__
+        setattr_(self, "n", _index(self.n))
+        setattr_(self, "rho", _colour_value(self.rho, "rho"))
+        setattr_(self, "single", _colour_value(self.single, "single"))
+        setattr_(self, "g", _validate.asymmetry(self.g))
+        setattr_(self, "slope", _validate.rms_slope(self.slope))
+        setattr_(self, "distribution", _validate.distribution(self.distribution))
+        try:
+            facet = float(self.facet)
+        except (TypeError, ValueError):
+            raise ValueError(f"facet must be a finite number >= 0, got {self.facet!r}") from None
+        if not math.isfinite(facet) or facet < 0:
+            raise ValueError(f"facet must be a finite number >= 0, got {self.facet!r}")
+        setattr_(self, "facet", facet)
+        setattr_(self, "space", cm.working_space(self.space))
+        if self.dispersive and not self.spectral:
+            raise ValueError("n as Cauchy coefficients needs a spectral paint (rho or single given as a Spectrum)")
+        if self.spectral:
+            for key in ("rho", "single"):
+                value = getattr(self, key)
+                if not isinstance(value, cm.Spectrum) and len(set(value)) != 1:
+                    raise ValueError(f"{key} must be a Spectrum or a grey value in a spectral paint, got RGB {value}")
+
+    # ------------------------------------------------------------------ description
+
+    @property
+    def spectral(self) -> bool:
+        return isinstance(self.rho, cm.Spectrum) or isinstance(self.single, cm.Spectrum)
+
+    @property
+    def dispersive(self) -> bool:
+        return isinstance(self.n, tuple)
+
+    @property
+    def has_single(self) -> bool:
+        values = self.single.values if isinstance(self.single, cm.Spectrum) else self.single
+        return bool(np.any(np.asarray(values) > 0))
+
+    @property
+    def has_diffuse(self) -> bool:
+        values = self.rho.values if isinstance(self.rho, cm.Spectrum) else self.rho
+        return bool(np.any(np.asarray(values) > 0))
+
+    def to_dict(self) -> dict:
+        """A JSON-able description that ``from_dict`` turns back into an
+        equal paint; spectra are stored as their sampled values."""
+
+        def colour(v):
+            if isinstance(v, cm.Spectrum):
+                return {"spectrum": v.name, "wavelengths": cm.WAVELENGTHS.tolist(), "values": v.key()}
+            return list(v)
+
+        return {
+            "n": list(self.n) if self.dispersive else self.n,
+            "rho": colour(self.rho),
+            "single": colour(self.single),
+            "g": self.g,
+            "slope": self.slope,
+            "distribution": self.distribution,
+            "facet": self.facet,
+            "space": self.space,
+            "name": self.name,
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> Paint:
+        """A paint from a dict as written by ``to_dict`` or by hand (JSON or
+        TOML): colours may be numbers, RGB lists, a spectrum dataset name
+        ``"ColorChecker N Ohta/red"``, a .csv path, or
+        {"wavelengths": [...], "values": [...]} (optionally with "scale")."""
+        if not isinstance(data, dict):
+            raise ValueError("a paint description must be a table/object of fields")
+        fields = {f.name for f in dataclasses.fields(cls)}
+        unknown = set(data) - fields
+        if unknown:
+            raise ValueError(
+                f"unknown paint field(s) {', '.join(sorted(unknown))}; fields are {', '.join(sorted(fields))}"
+            )
+        kw = dict(data)
+        if isinstance(kw.get("n"), list):
+            kw["n"] = tuple(kw["n"])
+        return cls(**kw)
+
+    def index_at(self, wavelength_nm):
+        """n at a wavelength [nm]."""
+        if self.dispersive:
+            return _cauchy(self.n, np.asarray(wavelength_nm) / 1000.0)
+        return self.n
+
+    def converted(self, space: str) -> Paint:
+        """The same paint with results in another working space (RGB colour
+        values converted linearly with colour-science, Bradford adaptation)."""
+        space = cm.working_space(space)
+        if space == self.space:
+            return self
+        colour = cm._colour()
+
+        def conv(v):
+            if isinstance(v, cm.Spectrum):
+                return v
+            rgb = colour.RGB_to_RGB(
+                np.array(v),
+                cm.WORKING_SPACES[self.space],
+                cm.WORKING_SPACES[space],
+                chromatic_adaptation_transform="Bradford",
+            )
+            return tuple(float(x) for x in np.clip(rgb, 0.0, 1.0))
+
+        return dataclasses.replace(self, rho=conv(self.rho), single=conv(self.single), space=space)
+
+    # ------------------------------------------------------------------ evaluation
+
+    def _geometry(self, ti, ts, ps, n, single_nodes, diffuse_nodes):
+        """M00 of each term with unit weights (the diffuse one at ρ = 1) and
+        the interface's r̄.  Zero-weight terms are not computed; smooth paints
+        never run the rough models."""
+        out = {}
+        rough = self.slope > 0.0
+        if self.facet > 0.0 and rough:
+            out["facet"] = models.facet_reflection(
+                ti, ts, ps, n=n, slope=self.slope, distribution=self.distribution, mueller=False
+            )
+        if self.has_single:
+            if rough:
+                out["single"] = models.rough_single(
+                    ti, ts, ps, n=n, g=self.g, slope=self.slope, distribution=self.distribution,
+                    mueller=False, nodes=single_nodes,
+                )  # fmt: skip
+            else:
+                out["single"] = models.smooth_single(ti, ts, ps, n=n, g=self.g, mueller=False)
+        if self.has_diffuse:
+            if rough:
+                out["diffuse"] = models.rough_diffuse(
+                    ti, ts, ps, n=n, rho=1.0, slope=self.slope, distribution=self.distribution,
+                    mueller=False, nodes=diffuse_nodes,
+                )  # fmt: skip
+                out["rbar"] = models.rough_internal_reflectance(n, self.slope, self.distribution, diffuse_nodes)
+            else:
+                out["diffuse"] = models.smooth_diffuse(ti, ts, ps, n=n, rho=1.0, mueller=False)
+                out["rbar"] = models.internal_reflectance(n)
+        return out
+
+    def _weights(self, rbar, band=slice(None)):
+        """RGB weights of the terms: (facet, single, diffuse) as (3,) arrays,
+        integrating spectra over the wavelengths of ``band``."""
+        if self.spectral:
+            w = cm.spectral_weights(self.space)[:, band]
+            single = (
+                self.single.values[band]
+                if isinstance(self.single, cm.Spectrum)
+                else np.full(w.shape[1], self.single[0])
+            )
+            rho = self.rho.values[band] if isinstance(self.rho, cm.Spectrum) else np.full(w.shape[1], self.rho[0])
+            k = rho * (1.0 - rbar) / (1.0 - rho * rbar)
+            return self.facet * w.sum(axis=1), w @ single, w @ k
+        rho = np.asarray(self.rho)
+        k = rho * (1.0 - rbar) / (1.0 - rho * rbar)
+        return np.full(3, self.facet), np.asarray(self.single), k
+
+    def _bands(self):
+        """(n, wavelength selection) per evaluation of the geometry."""
+        if not self.dispersive:
+            return [(self.n, slice(None))]
+        centres = 0.5 * (DISPERSION_BANDS[:-1] + DISPERSION_BANDS[1:])
+        which = np.clip(np.searchsorted(DISPERSION_BANDS, cm.WAVELENGTHS, side="right") - 1, 0, len(centres) - 1)
+        return [(float(self.index_at(c)), which == b) for b, c in enumerate(centres)]
+
+    def brdf(self, theta_i, theta_s, phi_s, *, single_nodes=SINGLE_NODES, diffuse_nodes=DIFFUSE_NODES):
+        """Polarization-averaged RGB BRDF [sr⁻¹] of all non-delta terms, shape
+        broadcast(angles) + (3,), in the paint's working space.  Angles as in
+        ``lut.models`` (radians; source at azimuth π)."""
+        ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s)
+        out = np.zeros(ti.shape + (3,))
+        for n, band in self._bands():
+            geo = self._geometry(ti, ts, ps, n, single_nodes, diffuse_nodes)
+            w_facet, w_single, w_diffuse = self._weights(geo.get("rbar", 0.0), band)
+            for key, weight in (("facet", w_facet), ("single", w_single), ("diffuse", w_diffuse)):
+                if key in geo:
+                    out += geo[key][..., None] * weight
+        return out
+
+    def specular_reflectance(self, theta_i):
+        """RGB reflectance of the smooth interface's mirror reflection (a
+        delta in the BRDF): facet · ½(|r_s|² + |r_p|²) at θi, shape
+        theta_i.shape + (3,).  Zero for rough paints, whose interface
+        reflection is the facet lobe inside ``brdf``."""
+        ti = _validate.polar_angle(theta_i, "theta_i")
+        out = np.zeros(ti.shape + (3,))
+        if self.slope > 0.0 or self.facet == 0.0:
+            return out
+        up = ti < np.pi / 2
+        cos_i = np.where(up, np.cos(ti), 0.0)
+        for n, band in self._bands():
+            rs, rp = fresnel.reflection_coefficients(cos_i, n)
+            refl = np.where(up, 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2), 0.0)
+            white = cm.spectral_weights(self.space)[:, band].sum(axis=1) if self.spectral else np.ones(3)
+            out += refl[..., None] * self.facet * white
+        return out
+
+
+def _colour_from_json(value, name):
+    if isinstance(value, dict):
+        scale = value.get("scale", 1.0)
+        if "wavelengths" in value and "values" in value:
+            return cm.Spectrum(value["wavelengths"], value["values"], name=value.get("spectrum"), scale=scale)
+        if "spectrum" in value:
+            return cm.Spectrum(value["spectrum"], scale=scale)
+        raise ValueError(f"{name}: a spectrum needs 'wavelengths' and 'values', or 'spectrum' naming a dataset or .csv")
+    return cm.Spectrum(value)

@@ -1,0 +1,93 @@
+"""The angular table behind a LUT: the polarization-averaged BRDF on a grid of
+Rusinkiewicz half/difference angles (``lut.angles``), and its interpolation.
+
+Axes (nodes include both ends):
+  u  in [0, 1] with θh = (π/2)·u²: the square-root spacing of the half angle
+     puts nodes densely near θh = 0, where facet lobes are sharp (a lobe of
+     RMS slope s is about s radians wide in θh; with 64 nodes the first step
+     is 0.02°);
+  θd in [0, π/2], uniform;
+  φd in [0, π/2], uniform (isotropy, reciprocity and mirror symmetry fold
+     every φd there; ``lut.angles``).
+The table stores G = f · cos θi · cos θs rather than f: the facet term's
+1/(cos θi cos θs) would otherwise vary steeply along θd near the horizon,
+while G is smooth for every term.  Nodes below the horizon store G continued
+from the horizon (polar angles clamped to HORIZON_CLAMP), so cells straddling
+it interpolate smoothly.  Lookup is trilinear in (u, θd, φd), then divides
+by cos θi cos θs; it returns 0 at or below the horizon.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import angles
+
+#: Default (N_u, N_θd, N_φd): see docs/lut.md for the error it reaches.
+DEFAULT_RESOLUTION = (64, 32, 16)
+HALF_PI = np.pi / 2
+#: Polar angle at which nodes below the horizon are evaluated.
+HORIZON_CLAMP = np.radians(89.0)
+
+
+def axes(resolution):
+    """Node coordinates (θh, θd, φd) of a resolution (N_u, N_θd, N_φd)."""
+    n_u, n_d, n_p = resolution
+    u = np.linspace(0.0, 1.0, n_u)
+    return HALF_PI * u * u, np.linspace(0.0, HALF_PI, n_d), np.linspace(0.0, HALF_PI, n_p)
+
+
+def node_directions(resolution):
+    """(θi, θs, φs) of every node, shape (N_φd, N_θd, N_u), with polar angles
+    clamped to HORIZON_CLAMP (the continuation below the horizon)."""
+    th, td, pd = axes(resolution)
+    ti, ts, ps = angles.from_half_diff(th[None, None, :], td[None, :, None], pd[:, None, None])
+    return np.minimum(ti, HORIZON_CLAMP), np.minimum(ts, HORIZON_CLAMP), ps
+
+
+def tabulate(brdf, resolution, chunk=8192, progress=None):
+    """G = brdf · cos θi · cos θs at every node, ``brdf(θi, θs, φs) -> (..., 3)``
+    evaluated in chunks, calling progress(done, total) after each.  Returns
+    float32 (N_φd, N_θd, N_u, 3)."""
+    ti, ts, ps = (a.ravel() for a in node_directions(resolution))
+    out = np.empty((ti.size, 3), dtype=np.float32)
+    for start in range(0, ti.size, chunk):
+        sl = slice(start, start + chunk)
+        out[sl] = brdf(ti[sl], ts[sl], ps[sl]) * (np.cos(ti[sl]) * np.cos(ts[sl]))[:, None]
+        if progress is not None:
+            progress(min(start + chunk, ti.size), ti.size)
+    n_u, n_d, n_p = resolution
+    return out.reshape(n_p, n_d, n_u, 3)
+
+
+def interpolate(table, theta_i, theta_s, phi_s):
+    """The BRDF at model angles from a table of G (N_φd, N_θd, N_u, C):
+    trilinear lookup divided by cos θi cos θs; zero at or below the horizon.
+    Returns broadcast(angles) + (C,)."""
+    n_p, n_d, n_u, _ = table.shape
+    ti, ts, ps = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (theta_i, theta_s, phi_s)))
+    th, td, pd = angles.to_half_diff(ti, ts, ps)
+    coords = (
+        np.clip(pd / HALF_PI, 0.0, 1.0) * (n_p - 1),
+        np.clip(td / HALF_PI, 0.0, 1.0) * (n_d - 1),
+        np.sqrt(np.clip(th / HALF_PI, 0.0, 1.0)) * (n_u - 1),
+    )
+    lo, frac = [], []
+    for c, size in zip(coords, (n_p, n_d, n_u), strict=True):
+        i = np.minimum(np.floor(c).astype(np.intp), max(size - 2, 0))
+        lo.append(i)
+        frac.append((c - i)[..., None] if size > 1 else np.zeros(c.shape + (1,)))
+    out = np.zeros(ti.shape + (table.shape[-1],))
+    for dp in (0, 1):
+        wp = frac[0] if dp else 1.0 - frac[0]
+        for dd in (0, 1):
+            wd = frac[1] if dd else 1.0 - frac[1]
+            for du in (0, 1):
+                wu = frac[2] if du else 1.0 - frac[2]
+                ip = np.minimum(lo[0] + dp, n_p - 1)
+                idd = np.minimum(lo[1] + dd, n_d - 1)
+                iu = np.minimum(lo[2] + du, n_u - 1)
+                out += wp * wd * wu * table[ip, idd, iu]
+    up = (ti < HALF_PI) & (ts < HALF_PI)
+    cos2 = np.where(up, np.cos(ti) * np.cos(ts), 1.0)
+    return np.where(up[..., None], out / cos2[..., None], 0.0)

@@ -1,0 +1,190 @@
+"""lut.bake and lut.load_lut: accuracy, metadata, cache, skipped work, and
+files that are damaged, foreign or interrupted."""
+
+import json
+
+import numpy as np
+import pytest
+
+import lut
+from lut import lutfile, models, table
+
+RNG = np.random.default_rng(9)
+
+PAINTS = {
+    "smooth": lut.Paint(n=1.5, rho=(0.8, 0.45, 0.15), single=(0.05, 0.2, 0.3), g=0.3),
+    "satin": lut.Paint(n=1.5, rho=(0.8, 0.45, 0.15), single=(0.05, 0.2, 0.3), g=0.3, slope=0.25),
+    "matte": lut.Paint(
+        n=1.5, rho=(0.8, 0.45, 0.15), single=(0.05, 0.2, 0.3), g=0.3, slope=2.0, distribution="exponential"
+    ),
+}
+
+
+@pytest.fixture(scope="module")
+def baked(tmp_path_factory):
+    directory = tmp_path_factory.mktemp("luts")
+    return {name: lut.bake(p, directory) for name, p in PAINTS.items()}
+
+
+@pytest.mark.parametrize("name", list(PAINTS))
+def test_lut_matches_the_model_within_one_percent(baked, name):
+    """cos-weighted relative RMS over θi, θs <= 80° and all azimuths."""
+    paint = PAINTS[name]
+    ti = np.radians(np.linspace(0.0, 80.0, 33))
+    tig, tsg, psg = np.meshgrid(ti, ti, np.linspace(-np.pi, np.pi, 40), indexing="ij")
+    model = paint.brdf(tig, tsg, psg)
+    got = lut.load_lut(baked[name]).evaluate(tig, tsg, psg)
+    w = np.cos(tig)[..., None]
+    err = np.sqrt(np.sum(((got - model) * w) ** 2) / np.sum((model * w) ** 2))
+    assert err < 0.01
+    assert got.shape == tig.shape + (3,)
+    assert np.all(lut.load_lut(baked[name]).evaluate(1.6, 0.3, 0.0) == 0)  # below the horizon
+
+
+def test_header_describes_the_bake(baked):
+    header = lutfile.read_header(baked["satin"])
+    meta = header["meta"]
+    assert meta["format"] == lutfile.FORMAT_VERSION
+    assert meta["resolution"] == list(table.DEFAULT_RESOLUTION)
+    assert meta["space"] == "Linear Rec.709"
+    assert meta["paint"]["slope"] == 0.25 and meta["paint"]["rho"] == [0.8, 0.45, 0.15]
+    assert meta["single_nodes"] == [4, 6] and meta["diffuse_nodes"] == [16, 16]
+    assert header["key"] == lutfile.cache_key(meta) and len(header["hash"]) == 64
+    assert "single_nodes" not in lutfile.read_header(baked["smooth"])["meta"]  # smooth: no quadrature
+    assert lut.load_lut(baked["matte"]).paint == PAINTS["matte"]
+
+
+def test_same_paint_is_a_cache_hit_that_computes_nothing(baked, monkeypatch):
+    def fail(*args, **kwargs):
+        raise AssertionError("computed on a cache hit")
+
+    monkeypatch.setattr(table, "tabulate", fail)
+    named = lut.Paint(**{**PAINTS["satin"].__dict__, "name": "my satin"})
+    assert lut.bake(named, baked["satin"].parent) == baked["satin"]
+    assert len({p.name for p in baked.values()}) == 3  # different paints, different files
+    other = lut.Paint(**{**PAINTS["satin"].__dict__, "rho": (0.8, 0.45, 0.16)})
+    assert lut.lut_path(other, baked["satin"].parent) != baked["satin"]
+
+
+def _count_calls(monkeypatch):
+    calls = []
+    for name in ("facet_reflection", "smooth_single", "smooth_diffuse", "rough_single", "rough_diffuse"):
+        original = getattr(models, name)
+
+        def wrapper(*args, _original=original, _name=name, **kwargs):
+            calls.append((_name, kwargs.get("mueller", True)))
+            return _original(*args, **kwargs)
+
+        monkeypatch.setattr(models, name, wrapper)
+    return calls
+
+
+def test_only_the_needed_terms_are_computed(tmp_path, monkeypatch):
+    calls = _count_calls(monkeypatch)
+    lut.bake(lut.Paint(n=1.5, rho=0.5, single=0.0), tmp_path, resolution=(8, 6, 4))
+    assert {c[0] for c in calls} == {"smooth_diffuse"}  # smooth paint, no single term: one model
+    calls.clear()
+    lut.bake(lut.Paint(n=1.5, rho=0.0, single=0.3, slope=0.2, facet=0.0), tmp_path, resolution=(8, 6, 4))
+    assert {c[0] for c in calls} == {"rough_single"}  # zero facet and ρ: neither computed
+    calls.clear()
+    lut.bake(lut.Paint(n=1.5, rho=0.5, single=0.3, slope=0.2), tmp_path, resolution=(8, 6, 4))
+    assert {c[0] for c in calls} == {"facet_reflection", "rough_single", "rough_diffuse"}
+    assert all(mueller is False for _, mueller in calls)  # M00 only
+
+
+def test_progress_is_reported(tmp_path):
+    seen = []
+    lut.bake(
+        lut.Paint(rho=0.3), tmp_path, resolution=(40, 30, 20), progress=lambda done, total: seen.append((done, total))
+    )
+    assert seen[-1][0] == seen[-1][1] == 40 * 30 * 20 and len(seen) > 1
+
+
+def test_missing_truncated_altered_and_foreign_files_are_refused(baked, tmp_path):
+    with pytest.raises(lut.LUTError, match="no such LUT file"):
+        lut.load_lut(tmp_path / "nothing.exr")
+    data = baked["smooth"].read_bytes()
+    truncated = tmp_path / "truncated.exr"
+    truncated.write_bytes(data[: len(data) // 2])
+    with pytest.raises(lut.LUTError, match="truncated"):
+        lut.load_lut(truncated)
+    (tmp_path / "junk.exr").write_bytes(b"not an image at all")
+    with pytest.raises(lut.LUTError, match="not a readable EXR"):
+        lut.load_lut(tmp_path / "junk.exr")
+    # Altered pixels under the original header.
+    table_, meta = lutfile.read(baked["smooth"])
+    altered = tmp_path / "altered.exr"
+    lutfile.write(altered, table_, meta)
+    oiio = lutfile._oiio()
+    buf = oiio.ImageBuf(str(altered))
+    pixels = buf.get_pixels(oiio.FLOAT)
+    pixels[3, 3, 0] += 0.01
+    buf.set_pixels(oiio.ROI(), pixels)
+    buf.write(str(altered))
+    with pytest.raises(lut.LUTError, match="does not match its hash"):
+        lut.load_lut(altered)
+
+
+def test_other_format_version_is_refused(baked, tmp_path, monkeypatch):
+    table_, meta = lutfile.read(baked["smooth"])
+    monkeypatch.setattr(lutfile, "FORMAT_VERSION", 99)
+    future = lutfile.write(tmp_path / "future.exr", table_, meta)
+    monkeypatch.undo()
+    with pytest.raises(lut.LUTError, match="format version 99; this version of Paint LUT reads 1"):
+        lut.load_lut(future)
+
+
+def test_damaged_cache_entry_is_baked_again(tmp_path):
+    paint = lut.Paint(rho=0.4, slope=0.1)
+    path = lut.bake(paint, tmp_path, resolution=(8, 6, 4))
+    good = path.read_bytes()
+    path.write_bytes(good[:100])
+    assert lut.bake(paint, tmp_path, resolution=(8, 6, 4)) == path
+    assert lut.load_lut(path).meta["resolution"] == [8, 6, 4]
+
+
+def test_interrupted_write_leaves_no_partial_file_and_keeps_the_old_one(tmp_path, monkeypatch):
+    paint = lut.Paint(rho=0.4)
+    path = lut.bake(paint, tmp_path, resolution=(8, 6, 4))
+    before = path.read_bytes()
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(table, "tabulate", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        lut.bake(paint, tmp_path, resolution=(8, 6, 4), force=True)
+    monkeypatch.undo()
+    oiio = lutfile._oiio()
+    original = oiio.ImageOutput.write_image
+
+    def failing_write(self, *args, **kwargs):
+        original(self, *args, **kwargs)
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(oiio.ImageOutput, "write_image", failing_write)
+    with pytest.raises(KeyboardInterrupt):
+        lut.bake(paint, tmp_path, resolution=(8, 6, 4), force=True)
+    assert path.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == [path.name]
+
+
+@pytest.mark.parametrize(
+    ("kw", "message"),
+    [
+        ({"resolution": (64, 1, 16)}, "resolution must be three whole numbers"),
+        ({"resolution": (64, 32)}, "resolution must be three whole numbers"),
+        ({"resolution": (64.5, 32, 16)}, "resolution must be three whole numbers"),
+        ({"single_nodes": (0, 4)}, r"single_nodes\[0\] must be a whole number >= 1"),
+    ],
+)
+def test_bad_bake_options(tmp_path, kw, message):
+    with pytest.raises(ValueError, match=message):
+        lut.bake(lut.Paint(rho=0.3, single=0.2, slope=0.2), tmp_path, **kw)
+    with pytest.raises(ValueError, match="paint must be a lut.Paint"):
+        lut.bake({"rho": 0.3}, tmp_path)
+
+
+def test_meta_is_plain_json(baked):
+    meta = lutfile.read_header(baked["matte"])["meta"]
+    assert json.loads(json.dumps(meta)) == meta
