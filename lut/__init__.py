@@ -5,7 +5,7 @@ paint; ``lut.bake`` writes a paint's LUT file and ``lut.load_lut`` reads it."""
 
 __version__ = "0.1.0"
 
-from .bake import LUT, bake, describe, load_lut, lut_path  # noqa: E402
+from .baking import LUT, bake, describe, load_lut, lut_path  # noqa: E402
 from .colour_management import Spectrum  # noqa: E402
 from .lutfile import LUTError  # noqa: E402
 from .paint import Paint  # noqa: E402

@@ -13,9 +13,12 @@ What the paper gives and what is our choice:
   reflectance, and ρ(λ) = that reflectance for the multiply scattered light
   (0.05 at 441.6 nm, where the paper notes the reflectance is low).
 * green_carc (Fig. 3): n 1.5, exponential slopes with RMS 2, g 0.3, ρ 0.05 at
-  632.8 nm (paper).  Our choice: ρ(λ) = the ColorChecker "foliage"
-  reflectance scaled to 0.05 at 632.8 nm, single(λ) = the same spectrum (equal
-  weights: the paper does not give the single-scatter weight), facet weight 1.
+  632.8 nm (paper).  Our choice: ρ(λ) = the ColorChecker (N. Ohta) "green"
+  pigment reflectance scaled to 0.05 at 632.8 nm (not "foliage", whose
+  chlorophyll edge above 700 nm no paint has); single = 1, the paper's Eq. 20
+  unweighted (no absorption): at that weight the Sec. 2.5 model's η at
+  n = 1.5 comes close to the facet model's at n = 1.2, which is the paper's
+  point about this sample, and the hue comes from ρ.  Facet weight 1.
 """
 
 from __future__ import annotations
@@ -45,13 +48,21 @@ def glossy_red(space: str = "Linear Rec.709") -> Paint:
 
 
 def green_carc(space: str = "Linear Rec.709") -> Paint:
-    foliage = Spectrum("ColorChecker N Ohta/foliage")
-    scale = 0.05 / float(foliage.at(632.8))
-    green = Spectrum("ColorChecker N Ohta/foliage", scale=scale, name="CARC green (foliage, 0.05 at 632.8 nm)")
+    pigment = Spectrum("ColorChecker N Ohta/green")
+    green = Spectrum(
+        "ColorChecker N Ohta/green", scale=0.05 / float(pigment.at(632.8)), name="CARC green, 0.05 at 632.8 nm"
+    )
     return Paint(
-        n=1.5, rho=green, single=green, g=0.3, slope=2.0, distribution="exponential", facet=1.0, space=space,
+        n=1.5,
+        rho=green,
+        single=Spectrum.flat(1.0),
+        g=0.3,
+        slope=2.0,
+        distribution="exponential",
+        facet=1.0,
+        space=space,
         name="green_carc",
-    )  # fmt: skip
+    )
 
 
 PRESETS = {"glossy_white": glossy_white, "glossy_red": glossy_red, "green_carc": green_carc}

@@ -1,0 +1,72 @@
+"""The command line: python -m lut example | bake | info."""
+
+import subprocess
+import sys
+
+import pytest
+
+from lut.__main__ import main
+
+SMALL = ["--resolution", "8", "6", "4"]
+
+
+def test_example_bakes_the_presets_and_draws_the_figures(tmp_path, capsys):
+    assert main(["example", "--out", str(tmp_path), *SMALL]) == 0
+    out = capsys.readouterr().out
+    for name in ("glossy_white", "glossy_red", "green_carc"):
+        assert name in out
+    assert len(list((tmp_path / "luts").glob("paintlut-*.exr"))) == 3
+    assert sorted(p.name for p in (tmp_path / "figures").iterdir()) == [
+        "fig1.png",
+        "fig2_red.png",
+        "fig2_white.png",
+        "fig3_carc.png",
+    ]
+
+
+def test_bake_from_options_toml_and_json_then_info(tmp_path, capsys):
+    assert (
+        main(["bake", "--rho", "0.7", "0.3", "0.1", "--single", "0.2", "--g", "0.4", "--out", str(tmp_path), *SMALL])
+        == 0
+    )
+    first = capsys.readouterr().out.split()[0]
+    toml = tmp_path / "paint.toml"
+    toml.write_text('rho = [0.7, 0.3, 0.1]\nsingle = 0.2\ng = 0.4\nname = "same paint"\n')
+    assert main(["bake", "--paint", str(toml), "--out", str(tmp_path), *SMALL]) == 0
+    assert capsys.readouterr().out.split()[0] == first  # the same paint: the same (cached) file
+    json_file = tmp_path / "paint.json"
+    json_file.write_text('{"rho": "ColorChecker N Ohta/red", "slope": 0.2}')
+    assert main(["bake", "--paint", str(json_file), "--out", str(tmp_path), *SMALL]) == 0
+    second = capsys.readouterr().out.split()[0]
+    assert second != first
+    assert main(["info", second]) == 0
+    info = capsys.readouterr().out
+    assert "content hash" in info and "(verified)" in info and "ColorChecker N Ohta/red" in info
+    assert main(["bake", "--preset", "glossy_white", "--space", "ACEScg", "--out", str(tmp_path), *SMALL]) == 0
+    aces = capsys.readouterr().out.split()[0]
+    assert main(["info", aces]) == 0
+    assert "working space   ACEScg" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["bake", "--rho", "2"], "error: rho must be a real number in [0, 1], got 2.0"),
+        (["bake", "--slope", "-1"], "error: slope must be a finite real number >= 0"),
+        (["bake", "--paint", "missing.toml"], "error: cannot read paint file 'missing.toml'"),
+        (["info", "missing.exr"], "error: missing.exr: no such LUT file"),
+    ],
+)
+def test_errors_are_one_line(argv, message, tmp_path, capsys):
+    assert main([*argv[:1], *argv[1:], *(["--out", str(tmp_path)] if argv[0] == "bake" else [])]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.startswith(message) and "\n" not in err
+
+
+def test_bad_toml_and_help(tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text("rho = [0.1,\n")
+    assert main(["bake", "--paint", str(bad), "--out", str(tmp_path)]) == 2
+    assert "is not valid TOML" in capsys.readouterr().err
+    run = subprocess.run([sys.executable, "-m", "lut", "bake", "--help"], capture_output=True, text=True)
+    assert run.returncode == 0 and "--preset" in run.stdout and "hash of its inputs" in run.stdout
