@@ -16,7 +16,8 @@ import time
 import tomllib
 
 from . import __version__, baking, colour_management, examples, figures, lutfile, presets, table
-from .models.rough import DIFFUSE_NODES, SINGLE_NODES
+from .baking import BAKE_SINGLE_NODES
+from .models.rough import DIFFUSE_NODES
 from .paint import Paint
 
 DEFAULT_OUT = "out"
@@ -147,7 +148,7 @@ def main(argv=None) -> int:
             default=table.DEFAULT_RESOLUTION,
             help="LUT size along the half-angle, difference-angle and difference-azimuth axes (default: %(default)s)",
         )  # fmt: skip
-        p.add_argument("--single-nodes", type=int, nargs=2, default=SINGLE_NODES, metavar=("RADIAL", "AZIMUTHAL"),
+        p.add_argument("--single-nodes", type=int, nargs=2, default=BAKE_SINGLE_NODES, metavar=("RADIAL", "AZIMUTHAL"),
                        help="quadrature of the rough single-scatter term (default: %(default)s)")  # fmt: skip
         p.add_argument("--diffuse-nodes", type=int, nargs=2, default=DIFFUSE_NODES, metavar=("RADIAL", "AZIMUTHAL"),
                        help="quadrature of the rough diffuse term (default: %(default)s)")  # fmt: skip

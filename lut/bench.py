@@ -137,3 +137,51 @@ def speedup_at_equal_error(rows, target_method):
     c_time = secs[-1] / pairs[-1]  # time per pair, from the largest run
     needed = (c_err / target["rms_error"]) ** 2
     return needed * c_time / target["seconds"], needed
+
+
+#: Bake settings the bake benchmark sweeps: (resolution, single-scatter nodes).
+BAKE_SETTINGS = [
+    ((32, 16, 8), (3, 4)),
+    ((48, 24, 12), (3, 4)),
+    ((64, 32, 16), (3, 4)),
+    ((64, 32, 16), (4, 6)),
+    ((96, 48, 24), (4, 6)),
+]
+
+
+def validation_angles(count=2000, seed=4):
+    """Random directions with θi, θs <= 80° and any azimuth."""
+    rng = np.random.default_rng(seed)
+    limit = np.radians(80.0)
+    return rng.uniform(0, limit, count), rng.uniform(0, limit, count), rng.uniform(-np.pi, np.pi, count)
+
+
+def cos_weighted_error(got, ref, theta_i):
+    """sqrt(Σ((lut - model)·cos θi)² / Σ(model·cos θi)²) over all channels."""
+    w = np.cos(theta_i)[..., None]
+    return float(np.sqrt(np.sum(((got - ref) * w) ** 2) / np.sum((ref * w) ** 2)))
+
+
+def bake_time_vs_error(paints, settings=BAKE_SETTINGS, directory=None, count=2000):
+    """For each paint and setting: bake time (forced, no cache) and the LUT's
+    cos-weighted relative RMS error against the model with converged
+    quadrature, on ``count`` random directions.  Returns {name: [rows]}."""
+    import tempfile
+
+    from . import baking
+
+    ti, ts, ps = validation_angles(count)
+    report = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        directory = directory or tmp
+        for name, paint in paints.items():
+            ref = paint.brdf(ti, ts, ps, single_nodes=(12, 16), diffuse_nodes=(32, 32))
+            rows = []
+            for resolution, single_nodes in settings:
+                start = time.perf_counter()
+                path = baking.bake(paint, directory, resolution=resolution, single_nodes=single_nodes, force=True)
+                seconds = time.perf_counter() - start
+                err = cos_weighted_error(baking.load_lut(path).evaluate(ti, ts, ps), ref, ti)
+                rows.append({"resolution": resolution, "single_nodes": single_nodes, "seconds": seconds, "error": err})
+            report[name] = rows
+    return report

@@ -48,7 +48,7 @@ def test_header_describes_the_bake(baked):
     assert meta["resolution"] == list(table.DEFAULT_RESOLUTION)
     assert meta["space"] == "Linear Rec.709"
     assert meta["paint"]["slope"] == 0.25 and meta["paint"]["rho"] == [0.8, 0.45, 0.15]
-    assert meta["single_nodes"] == [4, 6] and meta["diffuse_nodes"] == [16, 16]
+    assert meta["single_nodes"] == [3, 4] and meta["diffuse_nodes"] == [16, 16]
     assert header["key"] == lutfile.cache_key(meta) and len(header["hash"]) == 64
     assert "single_nodes" not in lutfile.read_header(baked["smooth"])["meta"]  # smooth: no quadrature
     assert lut.load_lut(baked["matte"]).paint == PAINTS["matte"]
