@@ -43,14 +43,6 @@ def _resolution(value):
     return res
 
 
-def _nodes(value, name):
-    try:
-        a, b = value
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be two whole numbers >= 1, got {value!r}") from None
-    return (_validate.positive_int(a, f"{name}[0]"), _validate.positive_int(b, f"{name}[1]"))
-
-
 def describe(
     paint: Paint, resolution=table.DEFAULT_RESOLUTION, single_nodes=BAKE_SINGLE_NODES, diffuse_nodes=DIFFUSE_NODES
 ):
@@ -69,9 +61,9 @@ def describe(
         "paint": paint_dict,
     }
     if paint.slope > 0 and paint.has_single:
-        meta["single_nodes"] = list(_nodes(single_nodes, "single_nodes"))
+        meta["single_nodes"] = list(_validate.nodes(single_nodes, "single_nodes"))
     if paint.slope > 0 and paint.has_diffuse:
-        meta["diffuse_nodes"] = list(_nodes(diffuse_nodes, "diffuse_nodes"))
+        meta["diffuse_nodes"] = list(_validate.nodes(diffuse_nodes, "diffuse_nodes"))
     return meta
 
 

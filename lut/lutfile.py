@@ -36,13 +36,13 @@ class LUTError(ValueError):
 
 
 def _oiio():
+    """The OpenImageIO module.  Inside Blender the add-on layer makes Blender's
+    bundled module importable first (bpy.utils.expose_bundled_modules());
+    ``lut`` itself never imports bpy."""
     try:
         import OpenImageIO as oiio
-    except ImportError:  # Blender's bundled module, exposed by bpy
-        import bpy  # noqa: F401
-
-        bpy.utils.expose_bundled_modules()
-        import OpenImageIO as oiio
+    except ImportError:
+        raise ImportError("Paint LUT files need the OpenImageIO Python module (pip install OpenImageIO)") from None
     return oiio
 
 

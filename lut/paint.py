@@ -277,8 +277,8 @@ class Paint:
         """Polarization-averaged RGB BRDF [sr⁻¹] of all non-delta terms, shape
         broadcast(angles) + (3,), in the paint's working space.  Angles as in
         ``lut.models`` (radians; source at azimuth π)."""
-        ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s)
-        out = np.zeros(ti.shape + (3,))
+        ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s, broadcast=False)
+        out = np.zeros(np.broadcast_shapes(ti.shape, ts.shape, ps.shape) + (3,))
         for n, band in self._bands():
             geo = self._geometry(ti, ts, ps, n, single_nodes, diffuse_nodes)
             w_facet, w_single, w_diffuse = self._weights(geo.get("rbar", 0.0), band)

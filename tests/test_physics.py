@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 from helpers import hemispherical, relative_rms
 
-from lut import models
+from lut import figures, models
 from lut.models import facet, fresnel, geometry, phase
 
 RNG = np.random.default_rng(7)
@@ -150,23 +150,13 @@ def test_fig1_peak_moves_towards_the_incident_angle_as_slopes_widen():
     assert 50.0 < peaks[-1] < 60.0
 
 
-def _sin_mean_angle(theta_i, sigma, n=1.5):
-    x, w = np.polynomial.legendre.leggauss(200)
-    tt, wt = 0.25 * np.pi * (x + 1), 0.25 * np.pi * w
-    pt = (np.arange(128) + 0.5) * 2 * np.pi / 128 - np.pi
-    t, p = np.meshgrid(tt, pt, indexing="ij")
-    f = models.facet_transmission(theta_i, t, p, n=n, slope=sigma, mueller=False)
-    dw = np.sin(t) * wt[:, None]
-    return np.sin(np.sum(t * f * dw) / np.sum(f * dw))
-
-
 def test_fig1_mean_angle_follows_snell_then_a_lower_index():
     """Fig. 1 (right): for narrow slopes sin<θt> = sin θi / n; wider slopes
     follow Snell's law with a substantially lower effective index."""
     angles = np.radians([30.0, 50.0, 70.0])
-    narrow = np.array([_sin_mean_angle(a, 0.05) for a in angles]) / np.sin(angles)
+    narrow = np.array([figures.mean_refraction_sine(a, 0.05) for a in angles]) / np.sin(angles)
     np.testing.assert_allclose(narrow, 1 / 1.5, rtol=0.01)
-    n_eff = {s: np.sin(angles) / np.array([_sin_mean_angle(a, s) for a in angles]) for s in (0.5, 1.0)}
+    n_eff = {s: np.sin(angles) / np.array([figures.mean_refraction_sine(a, s) for a in angles]) for s in (0.5, 1.0)}
     assert np.all(n_eff[0.5] < 1.36) and np.all(n_eff[0.5] > 1.2)
     assert np.all(n_eff[1.0] < n_eff[0.5]) and np.all(n_eff[1.0] > 1.0)
 

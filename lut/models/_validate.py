@@ -69,6 +69,15 @@ def positive_int(value: int, name: str, minimum: int = 1) -> int:
     return int(value)
 
 
+def nodes(value, name: str = "nodes") -> tuple[int, int]:
+    """A (radial, azimuthal) quadrature size: two whole numbers >= 1."""
+    try:
+        radial, azimuthal = value
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be two whole numbers >= 1, got {value!r}") from None
+    return positive_int(radial, f"{name}[0]"), positive_int(azimuthal, f"{name}[1]")
+
+
 def polar_angle(theta, name: str) -> np.ndarray:
     """Polar angle in radians, in [0, pi]; values >= pi/2 lie at or below the
     horizon and give zero BSDF."""

@@ -193,6 +193,16 @@ def _rows_at(theta, n, slope, distribution, nodes):
     return rows.reshape(theta.shape + (4,))
 
 
+def _interface(n, slope, distribution, nodes):
+    """Validated parameters of the rough interface and its quadrature."""
+    return (
+        _validate.index(n),
+        _validate.rms_slope(slope),
+        _validate.distribution(distribution),
+        _validate.nodes(nodes),
+    )
+
+
 def rough_diffuse(
     theta_i, theta_s, phi_s, *, n, rho, slope, distribution="gaussian", mueller=True, nodes=DIFFUSE_NODES
 ):
@@ -205,11 +215,8 @@ def rough_diffuse(
     'exponential'; nodes the (radial, azimuthal) sizes of the visible-normal
     rule.  Returns broadcast(angles) + (4, 4), or M00 with ``mueller=False``.
     The result does not depend on phi_s."""
-    n = _validate.index(n)
+    n, slope, distribution, nodes = _interface(n, slope, distribution, nodes)
     rho = _validate.reflectance(rho)
-    slope = _validate.rms_slope(slope)
-    distribution = _validate.distribution(distribution)
-    nodes = (_validate.positive_int(nodes[0], "nodes[0]"), _validate.positive_int(nodes[1], "nodes[1]"))
     ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s)
     if slope == 0.0:
         return smooth.smooth_diffuse(ti, ts, ps, n=n, rho=rho, mueller=mueller)
@@ -255,11 +262,8 @@ def rough_single(theta_i, theta_s, phi_s, *, n, g, slope, distribution="gaussian
     sizes of the visible-normal rule used for both the entry and the exit
     facets (all pairs are summed).  Returns broadcast(angles) + (4, 4), or M00
     with ``mueller=False``."""
-    n = _validate.index(n)
+    n, slope, distribution, nodes = _interface(n, slope, distribution, nodes)
     g = _validate.asymmetry(g)
-    slope = _validate.rms_slope(slope)
-    distribution = _validate.distribution(distribution)
-    nodes = (_validate.positive_int(nodes[0], "nodes[0]"), _validate.positive_int(nodes[1], "nodes[1]"))
     ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s)
     if slope == 0.0:
         return smooth.smooth_single(ti, ts, ps, n=n, g=g, mueller=mueller)
