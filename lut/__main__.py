@@ -94,8 +94,7 @@ def _cmd_bake(args) -> int:
 
 
 def _cmd_info(args) -> int:
-    header = lutfile.read_header(args.file)
-    lutfile.read(args.file)  # verifies the content hash
+    _, header = lutfile.read(args.file)  # verifies the content hash
     meta = header["meta"]
     width, height, channels = header["size"]
     print(f"{args.file}: Paint LUT format {meta['format']}, {width}x{height} pixels, {channels} channels (Non-Color)")

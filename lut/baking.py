@@ -90,8 +90,7 @@ def bake(
     path = pathlib.Path(directory) / f"paintlut-{lutfile.cache_key(meta)[:24]}.exr"
     if path.exists() and not force:
         try:
-            if lutfile.read_header(path)["key"] == lutfile.cache_key(meta):
-                lutfile.read(path)  # verifies the content hash
+            if lutfile.read(path)[1]["key"] == lutfile.cache_key(meta):  # read verifies the content hash
                 return path
         except lutfile.LUTError:
             pass  # damaged or foreign: bake it again
@@ -129,5 +128,5 @@ class LUT:
 def load_lut(path) -> LUT:
     """Load and verify a LUT file.  Raises lut.LUTError (a ValueError) for a
     missing, truncated or altered file, or one of another format version."""
-    data, meta = lutfile.read(path)
-    return LUT(data, meta, pathlib.Path(path))
+    data, header = lutfile.read(path)
+    return LUT(data, header["meta"], pathlib.Path(path))

@@ -100,8 +100,8 @@ def write(path, table: np.ndarray, meta: dict) -> pathlib.Path:
     return path
 
 
-def read_header(path) -> dict:
-    """The meta of a LUT file (checks the format version, not the pixels)."""
+def _open(path):
+    """An open ImageInput of a LUT file and its header; raises LUTError."""
     oiio = _oiio()
     path = pathlib.Path(path)
     if not path.is_file():
@@ -117,22 +117,31 @@ def read_header(path) -> dict:
         if int(version) != FORMAT_VERSION:
             raise LUTError(f"{path}: LUT format version {version}; this version of Paint LUT reads {FORMAT_VERSION}")
         meta_json = spec.getattribute("paintlut:meta")
-        return {
+        header = {
             "meta": json.loads(meta_json),
             "meta_json": meta_json,
             "key": spec.getattribute("paintlut:key"),
             "hash": spec.getattribute("paintlut:hash"),
             "size": (spec.width, spec.height, spec.nchannels),
         }
-    finally:
+    except BaseException:
         inp.close()
+        raise
+    return inp, header
+
+
+def read_header(path) -> dict:
+    """The header of a LUT file (checks the format version, not the pixels):
+    meta, meta_json, key, hash and size (width, height, channels)."""
+    inp, header = _open(path)
+    inp.close()
+    return header
 
 
 def read(path):
-    """(table, meta) of a LUT file, verified against its content hash."""
+    """(table, header) of a LUT file, verified against its content hash."""
     oiio = _oiio()
-    header = read_header(path)
-    inp = oiio.ImageInput.open(str(path))
+    inp, header = _open(path)
     try:
         pixels = inp.read_image(oiio.FLOAT)
     finally:
@@ -147,4 +156,4 @@ def read(path):
     n_u, n_d, n_p = meta["resolution"]
     if pixels.shape != (n_p * n_d, n_u, 3):
         raise LUTError(f"{path}: image size {pixels.shape} does not match resolution {meta['resolution']}")
-    return np.asarray(pixels, dtype=np.float32).reshape(n_p, n_d, n_u, 3), meta
+    return np.asarray(pixels, dtype=np.float32).reshape(n_p, n_d, n_u, 3), header

@@ -112,9 +112,9 @@ def test_missing_truncated_altered_and_foreign_files_are_refused(baked, tmp_path
     with pytest.raises(lut.LUTError, match="not a readable EXR"):
         lut.load_lut(tmp_path / "junk.exr")
     # Altered pixels under the original header.
-    table_, meta = lutfile.read(baked["smooth"])
+    table_, header = lutfile.read(baked["smooth"])
     altered = tmp_path / "altered.exr"
-    lutfile.write(altered, table_, meta)
+    lutfile.write(altered, table_, header["meta"])
     oiio = lutfile._oiio()
     buf = oiio.ImageBuf(str(altered))
     pixels = buf.get_pixels(oiio.FLOAT)
@@ -126,9 +126,9 @@ def test_missing_truncated_altered_and_foreign_files_are_refused(baked, tmp_path
 
 
 def test_other_format_version_is_refused(baked, tmp_path, monkeypatch):
-    table_, meta = lutfile.read(baked["smooth"])
+    table_, header = lutfile.read(baked["smooth"])
     monkeypatch.setattr(lutfile, "FORMAT_VERSION", 99)
-    future = lutfile.write(tmp_path / "future.exr", table_, meta)
+    future = lutfile.write(tmp_path / "future.exr", table_, header["meta"])
     monkeypatch.undo()
     with pytest.raises(lut.LUTError, match="format version 99; this version of Paint LUT reads 1"):
         lut.load_lut(future)

@@ -51,11 +51,6 @@ def jones_to_mueller(jones: np.ndarray) -> np.ndarray:
     return m
 
 
-def jones_m00(jones: np.ndarray) -> np.ndarray:
-    """M00 of M(J) alone: ½ Σ|J_ab|² (the polarization-averaged part)."""
-    return 0.5 * np.sum(np.abs(jones) ** 2, axis=(-2, -1))
-
-
 def polarization_parameters(mueller: np.ndarray, stokes_in=STOKES_45) -> dict:
     """The paper's plotted quantities (Sec. 3) for a Mueller BRDF and an
     incident Stokes vector (default 45° linear, the paper's measurement).
