@@ -1,0 +1,32 @@
+"""Paint LUT Blender extension: the Blender-facing layer.
+
+Properties, panels and operators live here; all physics and file formats are
+in ``lut``.  Work in progress (issue 4): the node groups that render the LUTs
+in Cycles and EEVEE are not built yet, so a bake writes the LUT and records
+it on the material without changing the render."""
+
+import bpy
+
+from . import operators, panels, properties
+
+_MODULES = (properties, operators, panels)
+
+
+def _expose_openimageio():
+    """lut writes EXR files with OpenImageIO: inside Blender use the bundled
+    module unless one is importable already."""
+    try:
+        import OpenImageIO  # noqa: F401
+    except ImportError:
+        bpy.utils.expose_bundled_modules()
+
+
+def register():
+    _expose_openimageio()
+    for module in _MODULES:
+        module.register()
+
+
+def unregister():
+    for module in reversed(_MODULES):
+        module.unregister()

@@ -1,0 +1,87 @@
+"""The Bake operator: runs addon.jobs.BakeJob in the background, shows its
+progress in the status bar, and is cancelled with Esc."""
+
+from __future__ import annotations
+
+import bpy
+
+from . import api, jobs
+
+
+class PAINTLUT_OT_bake(bpy.types.Operator):
+    """Bake the active material's paint into a lookup table"""
+
+    bl_idname = "paint_lut.bake"
+    bl_label = "Bake Paint"
+    bl_options = {"REGISTER"}
+
+    force: bpy.props.BoolProperty(name="Force", default=False, description="Bake even if a matching LUT exists")
+
+    _timer = None
+    _job = None
+    _material = None
+
+    @classmethod
+    def poll(cls, context):
+        return getattr(context, "material", None) is not None
+
+    def invoke(self, context, event):
+        self._material = context.material
+        try:
+            paint = api.paint_of(self._material)
+        except ValueError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        self._job = jobs.BakeJob(paint, api.lut_directory(), force=self.force).start()
+        wm = context.window_manager
+        self._timer = wm.event_timer_add(0.1, window=context.window)
+        wm.progress_begin(0, 100)
+        wm.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        """Blocking bake, for scripts without an event loop."""
+        try:
+            path = api.bake_material(context.material, force=self.force)
+        except ValueError as exc:
+            self.report({"ERROR"}, str(exc))
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"Baked {path.name}")
+        return {"FINISHED"}
+
+    def modal(self, context, event):
+        if event.type == "ESC":
+            self._job.cancel()
+        if event.type != "TIMER":
+            return {"PASS_THROUGH"}
+        context.window_manager.progress_update(int(100 * self._job.progress))
+        context.workspace.status_text_set(f"Paint LUT: baking {int(100 * self._job.progress)}%  (Esc to cancel)")
+        if not self._job.done:
+            return {"RUNNING_MODAL"}
+        self._finish(context)
+        if self._job.error:
+            level = {"WARNING"} if self._job.cancelled else {"ERROR"}
+            self.report(level, f"Paint LUT: {self._job.error}")
+            return {"CANCELLED"}
+        api.store_result(self._material, self._job.path)
+        self.report({"INFO"}, f"Baked {self._job.path.name}")
+        return {"FINISHED"}
+
+    def _finish(self, context):
+        wm = context.window_manager
+        wm.event_timer_remove(self._timer)
+        wm.progress_end()
+        context.workspace.status_text_set(None)
+
+
+CLASSES = (PAINTLUT_OT_bake,)
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

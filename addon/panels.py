@@ -1,0 +1,68 @@
+"""The Paint LUT panel, in Material Properties and in the shader editor's sidebar."""
+
+from __future__ import annotations
+
+import bpy
+
+
+def draw_settings(layout, material):
+    settings = material.paint_lut
+    layout.prop(settings, "preset")
+    col = layout.column(align=False)
+    col.use_property_split = True
+    col.use_property_decorate = False
+    col.prop(settings, "rho")
+    col.prop(settings, "single")
+    col.prop(settings, "g")
+    col.prop(settings, "n")
+    col.prop(settings, "slope")
+    col.prop(settings, "distribution")
+    col.prop(settings, "facet")
+    row = layout.row()
+    row.operator("paint_lut.bake", icon="RENDER_STILL")
+    if settings.stale:
+        layout.label(text="Changed since the last bake", icon="ERROR")
+    elif settings.lut_path:
+        layout.label(text=bpy.path.basename(settings.lut_path), icon="CHECKMARK")
+
+
+class MATERIAL_PT_paint_lut(bpy.types.Panel):
+    bl_label = "Paint LUT"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "material"
+
+    @classmethod
+    def poll(cls, context):
+        return getattr(context, "material", None) is not None
+
+    def draw(self, context):
+        draw_settings(self.layout, context.material)
+
+
+class NODE_PT_paint_lut(bpy.types.Panel):
+    bl_label = "Paint LUT"
+    bl_space_type = "NODE_EDITOR"
+    bl_region_type = "UI"
+    bl_category = "Paint LUT"
+
+    @classmethod
+    def poll(cls, context):
+        space = context.space_data
+        return getattr(space, "tree_type", None) == "ShaderNodeTree" and getattr(context, "material", None) is not None
+
+    def draw(self, context):
+        draw_settings(self.layout, context.material)
+
+
+CLASSES = (MATERIAL_PT_paint_lut, NODE_PT_paint_lut)
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

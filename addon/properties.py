@@ -1,0 +1,137 @@
+"""The paint settings stored on every material: ``material.paint_lut``.
+
+Every ``lut.Paint`` field, with the same limits, plus the preset, the baked
+LUT's path and a stale flag.  Choosing a preset fills the fields with the
+preset's values (its spectral colours shown as RGB in the scene's working
+space) and bakes use the preset's exact spectral paint; editing any physical
+field afterwards makes the paint "Custom"."""
+
+from __future__ import annotations
+
+import bpy
+
+import lut
+
+PRESET_ITEMS = [("CUSTOM", "Custom", "Paint given by the fields below")] + [
+    (name, name.replace("_", " ").title(), f"The paper's {name.replace('_', ' ')} sample") for name in lut.PRESETS
+]
+
+_applying_preset = False
+
+
+def working_space() -> str:
+    """The scene-linear working space of the open file, as a lut space name
+    (Blender 5.0: bpy.data.colorspace.working_space; earlier: Linear Rec.709)."""
+    colorspace = getattr(bpy.data, "colorspace", None)
+    name = getattr(colorspace, "working_space", "Linear Rec.709") if colorspace is not None else "Linear Rec.709"
+    return name if name in lut.colour_management.WORKING_SPACES else "Linear Rec.709"
+
+
+def _changed(self, context):
+    """A physical field changed: the LUT is stale, and the paint no longer a preset."""
+    self.stale = True
+    if not _applying_preset and self.preset != "CUSTOM":
+        self["preset"] = 0  # set the enum without re-running its update
+
+
+def _preset_changed(self, context):
+    global _applying_preset
+    self.stale = True
+    if self.preset == "CUSTOM":
+        return
+    paint = lut.preset(self.preset, working_space())
+    _applying_preset = True
+    try:
+        self.n = paint.n
+        self.rho = _rgb(paint.rho, paint.space)
+        self.single = _rgb(paint.single, paint.space)
+        self.g = paint.g
+        self.slope = paint.slope
+        self.distribution = paint.distribution.upper()
+        self.facet = paint.facet
+    finally:
+        _applying_preset = False
+
+
+def _exact(value):
+    """Blender stores float properties in single precision (0.8 reads back as
+    0.800000011920929); round to 6 decimals so the paint, and its cache key,
+    are those of the number the artist typed."""
+    return round(float(value), 6)
+
+
+def _rgb(value, space):
+    if isinstance(value, lut.Spectrum):
+        return tuple(float(v) for v in value.rgb(space).clip(0.0, 1.0))
+    return tuple(value)
+
+
+class PaintLUTSettings(bpy.types.PropertyGroup):
+    preset: bpy.props.EnumProperty(
+        name="Preset", items=PRESET_ITEMS, default="CUSTOM", update=_preset_changed,
+        description="One of the paper's three paints, or Custom",
+    )  # fmt: skip
+    n: bpy.props.FloatProperty(
+        name="Index", default=1.5, min=1.0, soft_max=2.0, max=4.0, precision=3, update=_changed,
+        description="Refractive index of the binder",
+    )  # fmt: skip
+    rho: bpy.props.FloatVectorProperty(
+        name="Diffuse", subtype="COLOR", size=3, default=(0.8, 0.8, 0.8), min=0.0, max=1.0, update=_changed,
+        description="Reflectance of the multiply scattering substrate (scene-linear RGB)",
+    )  # fmt: skip
+    single: bpy.props.FloatVectorProperty(
+        name="Single Scatter", subtype="COLOR", size=3, default=(0.0, 0.0, 0.0), min=0.0, max=1.0, update=_changed,
+        description="Weight of single scattering by pigment particles under the surface",
+    )  # fmt: skip
+    g: bpy.props.FloatProperty(
+        name="Anisotropy", default=0.0, min=-0.99, max=0.99, update=_changed,
+        description="Henyey-Greenstein asymmetry of single scattering (positive: forward)",
+    )  # fmt: skip
+    slope: bpy.props.FloatProperty(
+        name="Roughness Slope", default=0.0, min=0.0, soft_max=1.0, max=3.0, precision=3, update=_changed,
+        description="RMS slope of the surface (0: smooth, glossy; 2: very matte)",
+    )  # fmt: skip
+    distribution: bpy.props.EnumProperty(
+        name="Slopes",
+        items=[("GAUSSIAN", "Gaussian", "Gaussian slope distribution"),
+               ("EXPONENTIAL", "Exponential", "Exponential slope distribution")],
+        default="GAUSSIAN", update=_changed,
+    )  # fmt: skip
+    facet: bpy.props.FloatProperty(
+        name="Surface Reflection", default=1.0, min=0.0, max=1.0, update=_changed,
+        description="Weight of the reflection by the surface itself",
+    )  # fmt: skip
+    lut_path: bpy.props.StringProperty(name="LUT", subtype="FILE_PATH", description="The baked lookup table")
+    stale: bpy.props.BoolProperty(name="Needs Bake", default=True, description="The paint changed since the last bake")
+
+    def to_paint(self, space: str | None = None) -> lut.Paint:
+        """The lut.Paint these settings describe (a preset's exact spectral
+        paint while the preset is selected)."""
+        space = space or working_space()
+        if self.preset != "CUSTOM":
+            return lut.preset(self.preset, space)
+        return lut.Paint(
+            n=_exact(self.n),
+            rho=tuple(_exact(v) for v in self.rho),
+            single=tuple(_exact(v) for v in self.single),
+            g=_exact(self.g),
+            slope=_exact(self.slope),
+            distribution=self.distribution.lower(),
+            facet=_exact(self.facet),
+            space=space,
+        )
+
+
+CLASSES = (PaintLUTSettings,)
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+    bpy.types.Material.paint_lut = bpy.props.PointerProperty(type=PaintLUTSettings)
+
+
+def unregister():
+    del bpy.types.Material.paint_lut
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

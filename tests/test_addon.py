@@ -1,0 +1,99 @@
+"""The Blender add-on on the pip bpy module (5.0.1): registration, the
+material settings, presets, stale tracking and baking."""
+
+import numpy as np
+import pytest
+
+bpy = pytest.importorskip("bpy")
+
+import addon  # noqa: E402
+import lut  # noqa: E402
+from addon import api, jobs  # noqa: E402
+
+
+@pytest.fixture(scope="module", autouse=True)
+def registered():
+    addon.register()
+    yield
+    addon.unregister()
+
+
+@pytest.fixture
+def material():
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    return bpy.data.materials.new("paint")
+
+
+def test_register_and_unregister_cleanly():
+    addon.unregister()
+    assert not hasattr(bpy.types.Material, "paint_lut")
+    assert not hasattr(bpy.types, "PAINTLUT_OT_bake")
+    addon.register()
+    assert hasattr(bpy.types.Material, "paint_lut")
+    assert hasattr(bpy.ops.paint_lut, "bake")
+    assert hasattr(bpy.types, "MATERIAL_PT_paint_lut") and hasattr(bpy.types, "NODE_PT_paint_lut")
+
+
+def test_defaults_are_the_paint_defaults(material):
+    settings = material.paint_lut
+    assert settings.preset == "CUSTOM" and settings.stale
+    assert api.paint_of(material) == lut.Paint()
+
+
+def test_limits_follow_the_paint_limits():
+    props = addon.properties.PaintLUTSettings.bl_rna.properties
+    assert props["n"].hard_min == 1.0
+    assert props["g"].hard_min > -1.0 and props["g"].hard_max < 1.0
+    assert props["slope"].hard_min == 0.0 and props["slope"].hard_max == 3.0
+    assert tuple(props["rho"].default_array) == pytest.approx((0.8, 0.8, 0.8)) and props["rho"].hard_max == 1.0
+    assert props["facet"].hard_min == 0.0
+
+
+def test_preset_fills_the_fields_and_bakes_the_spectral_paint(material):
+    settings = material.paint_lut
+    settings.stale = False
+    settings.preset = "green_carc"
+    carc = lut.preset("green_carc")
+    assert settings.slope == pytest.approx(2.0) and settings.distribution == "EXPONENTIAL"
+    assert settings.g == pytest.approx(0.3)
+    np.testing.assert_allclose(tuple(settings.rho), np.clip(carc.rho.rgb(), 0, 1), rtol=1e-6)
+    assert settings.stale
+    assert api.paint_of(material) == carc  # the exact spectral paint, not its RGB
+
+
+def test_editing_a_field_makes_the_paint_custom_and_stale(material):
+    settings = material.paint_lut
+    settings.preset = "glossy_white"
+    settings.stale = False
+    settings.g = 0.5
+    assert settings.preset == "CUSTOM" and settings.stale
+    paint = api.paint_of(material)
+    assert paint.g == 0.5 and paint.rho == pytest.approx(tuple(settings.rho))
+
+
+def test_bake_records_the_lut_and_clears_stale(material, tmp_path, monkeypatch):
+    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
+    material.paint_lut.rho = (0.7, 0.2, 0.1)
+    path = api.bake_material(material, resolution=(8, 6, 4))
+    assert path.exists() and material.paint_lut.lut_path == str(path) and not material.paint_lut.stale
+    assert lut.load_lut(path).paint == api.paint_of(material)
+    material.paint_lut.slope = 0.2
+    assert material.paint_lut.stale
+
+
+def test_bake_operator_runs_headless(material, tmp_path, monkeypatch):
+    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
+    material.paint_lut.preset = "glossy_white"
+    with bpy.context.temp_override(material=material):
+        assert bpy.ops.paint_lut.bake("EXEC_DEFAULT") == {"FINISHED"}
+    assert not material.paint_lut.stale and material.paint_lut.lut_path.endswith(".exr")
+
+
+def test_background_job_reports_progress_and_can_be_cancelled(tmp_path):
+    job = jobs.BakeJob(lut.Paint(rho=0.5, single=0.3, slope=0.3), tmp_path, resolution=(8, 6, 4)).start()
+    assert job.wait(60) and job.error is None and job.progress == 1.0 and job.path.exists()
+    slow = jobs.BakeJob(lut.Paint(rho=0.4, single=0.3, slope=0.5), tmp_path, resolution=(96, 48, 24))
+    slow.cancel()
+    slow.start()
+    assert slow.wait(60) and slow.error == "cancelled" and slow.path is None
+    assert sorted(p.name for p in tmp_path.iterdir()) == [job.path.name]  # nothing half-written
