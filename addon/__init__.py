@@ -1,9 +1,9 @@
 """Paint LUT Blender extension: the Blender-facing layer.
 
 Properties, panels and operators live here; all physics and file formats are
-in ``lut``.  Work in progress (issue 4): the node groups that render the LUTs
-in Cycles and EEVEE are not built yet, so a bake writes the LUT and records
-it on the material without changing the render."""
+in ``lut``.  Work in progress (issue 4): a bake writes the LUT and, for
+smooth paints, a per-view closure fit wired into the material as a node
+group (Cycles); rough paints and EEVEE's own target are not done yet."""
 
 import bpy
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 import threading
 
 import lut
+from lut import closures
 
 
 class Cancelled(Exception):
@@ -21,6 +22,8 @@ class BakeJob:
         self.paint, self.directory, self.options = paint, directory, options
         self.progress = 0.0
         self.path = None
+        self.fit = None
+        self.weights = None
         self.error = None
         self._cancel = threading.Event()
         self._thread = threading.Thread(target=self._run, name="paint-lut-bake", daemon=True)
@@ -51,7 +54,13 @@ class BakeJob:
 
     def _run(self):
         try:
-            self.path = lut.bake(self.paint, self.directory, progress=self._progress, **self.options)
+            path = lut.bake(self.paint, self.directory, progress=self._progress, **self.options)
+            if self.paint.slope == 0:  # closure fits of rough paints are not implemented yet
+                self.fit = closures.fit(self.paint)
+                self.weights = closures.save_weights(
+                    self.fit, path.with_name(path.name.replace("paintlut-", "paintfit-"))
+                )
+            self.path = path
             self.progress = 1.0
         except Cancelled:
             self.error = "cancelled"

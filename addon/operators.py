@@ -20,6 +20,7 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
     _timer = None
     _job = None
     _material = None
+    _paint = None
 
     @classmethod
     def poll(cls, context):
@@ -32,6 +33,7 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
         except ValueError as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
+        self._paint = paint
         self._job = jobs.BakeJob(paint, api.lut_directory(), force=self.force).start()
         wm = context.window_manager
         self._timer = wm.event_timer_add(0.1, window=context.window)
@@ -63,7 +65,7 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
             level = {"WARNING"} if self._job.cancelled else {"ERROR"}
             self.report(level, f"Paint LUT: {self._job.error}")
             return {"CANCELLED"}
-        api.store_result(self._material, self._job.path)
+        api.store_result(self._material, self._paint, self._job.path, self._job.fit, self._job.weights)
         self.report({"INFO"}, f"Baked {self._job.path.name}")
         return {"FINISHED"}
 

@@ -65,23 +65,20 @@ def _to_image(table: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(table.reshape(n_p * n_d, n_u, c), dtype=np.float32)
 
 
-def write(path, table: np.ndarray, meta: dict) -> pathlib.Path:
-    """Write a table (N_φd, N_θd, N_u, 3) and its meta atomically: to a
-    temporary file in the same directory, renamed into place, so an
-    interrupted write never leaves a partial file under ``path``."""
+def write_exr(path, image: np.ndarray, attributes: dict) -> pathlib.Path:
+    """Write a float32 (height, width, 3) image with string/int attributes
+    atomically: to a temporary file in the same directory, renamed into
+    place, so an interrupted write never leaves a partial file under ``path``."""
     oiio = _oiio()
     path = pathlib.Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    image = _to_image(table)
-    meta_json = canonical_json(meta)
+    image = np.ascontiguousarray(image, dtype=np.float32)
     spec = oiio.ImageSpec(image.shape[1], image.shape[0], image.shape[2], oiio.FLOAT)
     spec.channelnames = ("R", "G", "B")
     spec.attribute("compression", "zip")
     spec.attribute("oiio:ColorSpace", "Non-Color")
-    spec.attribute("paintlut:format", FORMAT_VERSION)
-    spec.attribute("paintlut:meta", meta_json)
-    spec.attribute("paintlut:key", cache_key(meta))
-    spec.attribute("paintlut:hash", content_hash(meta_json, image))
+    for key, value in attributes.items():
+        spec.attribute(key, value)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".partial.exr")
     os.close(fd)
     try:
@@ -98,6 +95,22 @@ def write(path, table: np.ndarray, meta: dict) -> pathlib.Path:
         with contextlib.suppress(FileNotFoundError):
             os.remove(tmp)
     return path
+
+
+def write(path, table: np.ndarray, meta: dict) -> pathlib.Path:
+    """Write a LUT table (N_φd, N_θd, N_u, 3) and its meta atomically."""
+    image = _to_image(table)
+    meta_json = canonical_json(meta)
+    return write_exr(
+        path,
+        image,
+        {
+            "paintlut:format": FORMAT_VERSION,
+            "paintlut:meta": meta_json,
+            "paintlut:key": cache_key(meta),
+            "paintlut:hash": content_hash(meta_json, image),
+        },
+    )
 
 
 def _open(path):

@@ -97,3 +97,20 @@ def test_background_job_reports_progress_and_can_be_cancelled(tmp_path):
     slow.start()
     assert slow.wait(60) and slow.error == "cancelled" and slow.path is None
     assert sorted(p.name for p in tmp_path.iterdir()) == [job.path.name]  # nothing half-written
+
+
+def test_bake_wires_a_node_group_for_smooth_paints_only(material, tmp_path, monkeypatch):
+    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
+    material.paint_lut.preset = "glossy_white"
+    api.bake_material(material, resolution=(8, 6, 4))
+    output = next(nd for nd in material.node_tree.nodes if nd.type == "OUTPUT_MATERIAL")
+    source = output.inputs["Surface"].links[0].from_node
+    assert source.type == "GROUP" and source.node_tree.name == f"Paint LUT {material.name}"
+    image = next(nd.image for nd in source.node_tree.nodes if nd.type == "TEX_IMAGE")
+    assert image.colorspace_settings.name == "Non-Color"
+    assert sorted(p.name.split("-")[0] for p in tmp_path.iterdir()) == ["paintfit", "paintlut"]
+    rough = bpy.data.materials.new("rough")
+    rough.paint_lut.slope = 0.3
+    api.bake_material(rough, resolution=(8, 6, 4))
+    assert not rough.paint_lut.stale
+    assert not any(nd.type == "GROUP" for nd in rough.node_tree.nodes)  # rough fits: not implemented yet

@@ -12,7 +12,8 @@ pytest.importorskip("bpy")
 
 from blender_oracle import Oracle  # noqa: E402
 
-from lut import models  # noqa: E402
+import lut  # noqa: E402
+from lut import closures, models  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -55,3 +56,50 @@ def test_gaussian_facet_term_is_cycles_metallic_beckmann(oracle, n, slope):
         models.facet_reflection(1.3, 1.2, 0.0, n=n, slope=slope, mueller=False)
     )
     assert 0.97 < grazing < 1.0
+
+
+@pytest.mark.parametrize(
+    "closure",
+    [
+        closures.Closure("diffuse_toon", 0.4, 0.3),
+        closures.Closure("diffuse_toon", 1e-5, 1.0),
+        closures.Closure("glossy_toon", 0.4, 0.3),
+    ],
+)
+def test_toon_closures_match_cycles(oracle, closure):
+    toon = _surface(oracle, "ShaderNodeBsdfToon")
+    toon.component = "DIFFUSE" if closure.kind == "diffuse_toon" else "GLOSSY"
+    toon.inputs["Size"].default_value = closure.size
+    toon.inputs["Smooth"].default_value = closure.smooth
+    toon.inputs["Color"].default_value = (1.0, 1.0, 1.0, 1.0)  # the node's default is 0.8 grey
+    for geometry in ((0.1, 0.4, 0.3), (0.7, 0.4, 0.3), (0.9, 0.5, 0.0), (1.1, 0.8, 0.2), (0.5, 0.6, 2.5)):
+        got = oracle.radiance(*geometry)[0] / oracle.irradiance
+        assert got == pytest.approx(float(closure.evaluate(*geometry)), rel=1e-5, abs=1e-7)
+
+
+@pytest.mark.parametrize("name", ["glossy_white", "smooth single"])
+def test_smooth_paint_renders_within_two_percent(oracle, name, tmp_path, monkeypatch):
+    """The acceptance measure for smooth paints: rendered radiance against
+    Paint.brdf · cos θl for θl, θv <= 75° away from the mirror direction,
+    cos-weighted relative RMS <= 2%, through the add-on's own bake."""
+    import addon
+    from addon import api
+
+    paint = lut.preset("glossy_white") if name == "glossy_white" else lut.Paint(rho=(0.8, 0.4, 0.1), single=0.3, g=0.3)
+    addon.register()
+    try:
+        monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
+        monkeypatch.setattr(api, "paint_of", lambda material: paint)
+        material = oracle.material()
+        api.bake_material(material, resolution=(8, 6, 4))
+        num = den = 0.0
+        for tl in np.radians([0, 25, 50, 75]):
+            for tv in np.radians([5, 30, 55, 75]):
+                for phi in (0.6, 1.6, 2.8):
+                    got = oracle.radiance(tl, tv, phi) / oracle.irradiance
+                    ref = paint.brdf(tl, tv, phi) * math.cos(tl)
+                    num += np.sum(((got - ref) * math.cos(tl)) ** 2)
+                    den += np.sum((ref * math.cos(tl)) ** 2)
+        assert math.sqrt(num / den) < 0.02
+    finally:
+        addon.unregister()

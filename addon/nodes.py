@@ -1,0 +1,106 @@
+"""Node groups that render a paint: closures weighted per view angle.
+
+The group reads the closure weights w_k(θv) from a small Non-Color EXR
+(lut.closures.save_weights) at u = cos θv (Geometry Incoming · Normal) and
+row k, and sums the weighted closures; the smooth interface's mirror
+reflection is a Metallic BSDF (physical conductor, IOR n, no extinction,
+roughness 0: the exact dielectric Fresnel mirror in Blender 5.0) scaled by the
+facet weight.  Cycles only for now (issue 4)."""
+
+from __future__ import annotations
+
+import bpy
+
+from lut import closures
+
+GROUP_PREFIX = "Paint LUT"
+
+
+def _image(path):
+    image = bpy.data.images.load(str(path), check_existing=False)
+    image.colorspace_settings.name = "Non-Color"
+    return image
+
+
+def build_group(name, fitted: closures.Fit, weights_path, n):
+    """A shader node group rendering ``fitted`` (replaces a group of the same name)."""
+    old = bpy.data.node_groups.get(name)
+    if old is not None:
+        bpy.data.node_groups.remove(old)
+    group = bpy.data.node_groups.new(name, "ShaderNodeTree")
+    group.interface.new_socket(name="Shader", in_out="OUTPUT", socket_type="NodeSocketShader")
+    nodes, links = group.nodes, group.links
+    out = nodes.new("NodeGroupOutput")
+    geometry = nodes.new("ShaderNodeNewGeometry")
+    dot = nodes.new("ShaderNodeVectorMath")
+    dot.operation = "DOT_PRODUCT"
+    links.new(geometry.outputs["Incoming"], dot.inputs[0])
+    links.new(geometry.outputs["Normal"], dot.inputs[1])
+    views = len(fitted.cos_view)
+    # Texel centres: column j at u = (j + 0.5)/M holds cos θv = j/(M - 1).
+    to_u = nodes.new("ShaderNodeMath")
+    to_u.operation = "MULTIPLY_ADD"
+    to_u.use_clamp = True
+    links.new(dot.outputs["Value"], to_u.inputs[0])
+    to_u.inputs[1].default_value = (views - 1) / views
+    to_u.inputs[2].default_value = 0.5 / views
+    image = _image(weights_path)
+    rows = len(fitted.basis)
+    total = None
+    for k, closure in enumerate(fitted.basis):
+        coord = nodes.new("ShaderNodeCombineXYZ")
+        links.new(to_u.outputs[0], coord.inputs["X"])
+        coord.inputs["Y"].default_value = (k + 0.5) / rows
+        tex = nodes.new("ShaderNodeTexImage")
+        tex.image = image
+        tex.interpolation = "Linear"
+        tex.extension = "EXTEND"
+        links.new(coord.outputs[0], tex.inputs["Vector"])
+        bsdf = _closure_node(nodes, closure)
+        links.new(tex.outputs["Color"], bsdf.inputs["Color"])
+        total = bsdf if total is None else _add(nodes, links, total, bsdf)
+    if fitted.mirror > 0:
+        mirror = nodes.new("ShaderNodeBsdfMetallic")
+        mirror.distribution = "BECKMANN"
+        mirror.fresnel_type = "PHYSICAL_CONDUCTOR"
+        mirror.inputs["IOR"].default_value = (n, n, n)
+        mirror.inputs["Extinction"].default_value = (0.0, 0.0, 0.0)
+        mirror.inputs["Roughness"].default_value = 0.0
+        scaled = nodes.new("ShaderNodeMixShader")
+        scaled.inputs["Fac"].default_value = fitted.mirror
+        links.new(mirror.outputs[0], scaled.inputs[2])  # fac·mirror + (1 - fac)·nothing
+        total = _add(nodes, links, total, scaled)
+    links.new(total.outputs[0], out.inputs["Shader"])
+    return group
+
+
+def _closure_node(nodes, closure):
+    if closure.kind == "lambert":
+        node = nodes.new("ShaderNodeBsdfDiffuse")
+        node.inputs["Roughness"].default_value = 0.0
+        return node
+    node = nodes.new("ShaderNodeBsdfToon")
+    node.component = "DIFFUSE" if closure.kind == "diffuse_toon" else "GLOSSY"
+    node.inputs["Size"].default_value = closure.size
+    node.inputs["Smooth"].default_value = closure.smooth
+    return node
+
+
+def _add(nodes, links, a, b):
+    add = nodes.new("ShaderNodeAddShader")
+    links.new(a.outputs[0], add.inputs[0])
+    links.new(b.outputs[0], add.inputs[1])
+    return add
+
+
+def wire(material, group):
+    """Use the group as the material's surface (a group node into the output)."""
+    nodes, links = material.node_tree.nodes, material.node_tree.links
+    node = next((nd for nd in nodes if nd.type == "GROUP" and nd.name == GROUP_PREFIX), None)
+    if node is None:
+        node = nodes.new("ShaderNodeGroup")
+        node.name = GROUP_PREFIX
+    node.node_tree = group
+    output = next((nd for nd in nodes if nd.type == "OUTPUT_MATERIAL"), None) or nodes.new("ShaderNodeOutputMaterial")
+    links.new(node.outputs["Shader"], output.inputs["Surface"])
+    return node

@@ -1,0 +1,51 @@
+"""lut.closures: the per-view closure fit (numpy side)."""
+
+import numpy as np
+import pytest
+
+import lut
+from lut import closures
+
+
+def test_nnls_matches_scipy():
+    optimize = pytest.importorskip("scipy.optimize")
+    rng = np.random.default_rng(2)
+    for _ in range(20):
+        a, b = rng.random((50, 10)), rng.random(50) - 0.4
+        x = closures.nnls(a, b)
+        assert np.all(x >= 0)
+        np.testing.assert_allclose(x, optimize.nnls(a, b)[0], atol=1e-10)
+
+
+def test_toon_closures_integrate_to_their_cone():
+    """A Toon closure with no smoothing is a uniform cone: its hemispherical
+    integral of the contribution (cos included) over directions is 1."""
+    closure = closures.Closure("diffuse_toon", 0.5, 0.0)
+    theta = np.linspace(0, np.pi / 2, 200_001)
+    value = closure.evaluate(theta, 0.3, 0.0)
+    y = value * np.sin(theta)
+    integral = np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(theta)) * 2 * np.pi  # trapezoid rule
+    assert integral == pytest.approx(1.0, rel=1e-3)
+
+
+@pytest.mark.parametrize("name", ["glossy_white", "custom"])
+def test_smooth_paints_fit_within_one_percent(name):
+    paint = lut.preset("glossy_white") if name == "glossy_white" else lut.Paint(rho=(0.8, 0.4, 0.1), single=0.3, g=0.3)
+    fitted = closures.fit(paint)
+    assert fitted.error < 0.01
+    assert np.all(fitted.weights >= 0) and fitted.weights.shape == (len(fitted.basis), 32, 3)
+    assert fitted.mirror == paint.facet
+
+
+def test_rough_paints_are_not_fitted_yet(tmp_path):
+    with pytest.raises(ValueError, match="slope must be 0"):
+        closures.fit(lut.Paint(slope=0.3))
+    assert closures.fit_for_lut(lut.Paint(slope=0.3), tmp_path / "paintlut-x.exr") == (None, None)
+
+
+def test_weights_file_is_written_bottom_up(tmp_path):
+    fitted = closures.fit(lut.Paint(rho=0.5))
+    path = closures.save_weights(fitted, tmp_path / "w.exr")
+    oiio = lut.lutfile._oiio()
+    pixels = oiio.ImageBuf(str(path)).get_pixels(oiio.FLOAT)
+    np.testing.assert_allclose(pixels[-1], fitted.weights[0], rtol=1e-6)  # closure 0 in the bottom row
