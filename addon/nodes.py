@@ -5,11 +5,13 @@ The group reads the closure weights w_k(θv) from a small Non-Color EXR
 row k, and sums the weighted closures; the smooth interface's mirror
 reflection is a Metallic BSDF (physical conductor, IOR n, no extinction,
 roughness 0: the exact dielectric Fresnel mirror in Blender 5.0) scaled by the
-facet weight.  Cycles only for now (issue 4)."""
+facet weight, and rough paints' facet lobes are Metallic BSDFs of Beckmann
+roughness scaled by their (grey) weights.  Cycles only for now (issue 4)."""
 
 from __future__ import annotations
 
 import bpy
+import numpy as np
 
 from lut import closures
 
@@ -56,22 +58,43 @@ def build_group(name, fitted: closures.Fit, weights_path, n):
         tex.interpolation = "Linear"
         tex.extension = "EXTEND"
         links.new(coord.outputs[0], tex.inputs["Vector"])
+        if closure.grey:
+            # No colour input: scale by a Mix Shader factor, which clamps at
+            # 1, so a weight up to m is m copies of weight/m.
+            copies = max(1, int(np.ceil(fitted.weights[k].max() - 1e-9)))
+            scale = nodes.new("ShaderNodeMath")
+            scale.operation = "DIVIDE"
+            links.new(tex.outputs["Color"], scale.inputs[0])  # grey: every channel is the weight
+            scale.inputs[1].default_value = copies
+            lobe = nodes.new("ShaderNodeMixShader")
+            links.new(scale.outputs[0], lobe.inputs["Fac"])
+            links.new(_metallic(nodes, closure.ior, closure.roughness).outputs[0], lobe.inputs[2])
+            for _ in range(copies):
+                total = lobe if total is None else _add(nodes, links, total, lobe)
+            continue
         bsdf = _closure_node(nodes, closure)
         links.new(tex.outputs["Color"], bsdf.inputs["Color"])
         total = bsdf if total is None else _add(nodes, links, total, bsdf)
     if fitted.mirror > 0:
-        mirror = nodes.new("ShaderNodeBsdfMetallic")
-        mirror.distribution = "BECKMANN"
-        mirror.fresnel_type = "PHYSICAL_CONDUCTOR"
-        mirror.inputs["IOR"].default_value = (n, n, n)
-        mirror.inputs["Extinction"].default_value = (0.0, 0.0, 0.0)
-        mirror.inputs["Roughness"].default_value = 0.0
+        mirror = _metallic(nodes, n, 0.0)
         scaled = nodes.new("ShaderNodeMixShader")
         scaled.inputs["Fac"].default_value = fitted.mirror
         links.new(mirror.outputs[0], scaled.inputs[2])  # fac·mirror + (1 - fac)·nothing
         total = _add(nodes, links, total, scaled)
     links.new(total.outputs[0], out.inputs["Shader"])
     return group
+
+
+def _metallic(nodes, n, roughness):
+    """Metallic BSDF, Beckmann, physical conductor of IOR n without extinction:
+    the exact dielectric Fresnel microfacet lobe (Blender 5.0)."""
+    node = nodes.new("ShaderNodeBsdfMetallic")
+    node.distribution = "BECKMANN"
+    node.fresnel_type = "PHYSICAL_CONDUCTOR"
+    node.inputs["IOR"].default_value = (n, n, n)
+    node.inputs["Extinction"].default_value = (0.0, 0.0, 0.0)
+    node.inputs["Roughness"].default_value = roughness
+    return node
 
 
 def _closure_node(nodes, closure):

@@ -15,6 +15,12 @@ cos θl included (what Cycles' eval returns), for a white closure:
   (Cycles' bsdf_toon.h; checked against renders in tests).
 * ``glossy_toon``:  Glossy Toon BSDF, the same in the angle between l and the
   mirror of v.
+* ``metallic``:     Metallic BSDF, Beckmann, physical conductor of IOR n and
+  no extinction, roughness r: F·D(α = r²)·G/(4 cos θv), G the
+  height-correlated Smith term 1/(1 + Λ(θl) + Λ(θv)) with Beckmann's rational
+  Λ.  With α = s this is the paper's Gaussian facet term times G.  A *grey*
+  closure: it has no colour input, so its weight is one number for all
+  channels (a Mix Shader factor in the node group).
 
 Angles follow ``lut.models``: the light at polar angle θl and azimuth π, the
 viewer at (θv, φ), φ = 0 the mirror direction."""
@@ -37,6 +43,12 @@ class Closure:
     kind: str
     size: float = 0.0
     smooth: float = 0.0
+    ior: float = 1.5
+    roughness: float = 0.5
+
+    @property
+    def grey(self) -> bool:
+        return self.kind == "metallic"
 
     def evaluate(self, theta_l, theta_v, phi):
         if self.kind == "lambert":
@@ -49,7 +61,24 @@ class Closure:
             cos_rl = np.sin(theta_v) * np.cos(phi) * np.sin(theta_l) + np.cos(theta_v) * np.cos(theta_l)
             angle = np.arccos(np.clip(cos_rl, 0.0, 1.0))
             return _toon(angle, self.size, self.smooth)
+        if self.kind == "metallic":
+            from . import models
+
+            alpha = self.roughness**2
+            f = models.facet_reflection(theta_l, theta_v, phi, n=self.ior, slope=alpha, mueller=False)
+            g = 1.0 / (1.0 + _beckmann_lambda(theta_l, alpha) + _beckmann_lambda(theta_v, alpha))
+            return f * np.cos(theta_l) * g
         raise ValueError(f"unknown closure kind {self.kind!r}")
+
+
+def _beckmann_lambda(theta, alpha):
+    """Smith's Λ for Beckmann slopes, the usual rational approximation
+    (Walter et al. 2007), in a = 1/(α tan θ)."""
+    tan = np.tan(np.minimum(theta, np.pi / 2 - 1e-9))
+    a = 1.0 / np.maximum(alpha * tan, 1e-300)
+    ac = np.minimum(a, 1.6)  # Λ = 0 from a = 1.6 on
+    lam = (1.0 - 1.259 * ac + 0.396 * ac * ac) / (3.535 * ac + 2.181 * ac * ac)
+    return np.where(a < 1.6, lam, 0.0)
 
 
 def _toon(angle, size, smooth):
@@ -68,6 +97,21 @@ def smooth_basis():
     basis = [Closure("lambert"), Closure("diffuse_toon", 1e-5, 1.0)]
     basis += [Closure("diffuse_toon", a, s) for a in (0.3, 0.5, 0.6, 0.7, 0.8, 0.9) for s in (0.1, 0.3)]
     basis += [Closure("glossy_toon", a, 0.3) for a in (0.2, 0.4, 0.6, 0.8)]
+    return basis
+
+
+def basis_for(paint):
+    """The closures a paint is fitted with: the smooth basis, plus for rough
+    paints Metallic lobes (grey): for Gaussian slopes the paper's facet term
+    exactly (roughness sqrt(slope)); for exponential slopes, which no closure
+    reproduces, lobes of several roughnesses."""
+    basis = smooth_basis()
+    if paint.slope > 0:
+        n = float(paint.index_at(589.3))
+        if paint.distribution == "gaussian" and paint.slope <= 1.0:
+            basis.append(Closure("metallic", ior=n, roughness=float(np.sqrt(paint.slope))))
+        else:
+            basis += [Closure("metallic", ior=n, roughness=r) for r in (0.5, 0.7, 0.85, 1.0)]
     return basis
 
 
@@ -115,33 +159,42 @@ class Fit:
 
 
 def fit(paint, views=32, light_polar=24, azimuths=24, basis=None) -> Fit:
-    """Fit a smooth paint's non-delta BRDF · cos θl, per view cosine, as a
-    non-negative combination of ``basis`` closures (NNLS per channel, rows
-    weighted by cos θl as the fidelity measure is).  The smooth interface's
+    """Fit a paint's non-delta BRDF · cos θl, per view cosine, as a
+    non-negative combination of ``basis`` closures (default ``basis_for``):
+    one NNLS per view over the three channels together, coloured closures
+    with a weight per channel and grey ones with one weight shared by all,
+    rows weighted by cos θl as the fidelity measure is.  A smooth interface's
     mirror reflection is a delta: it is carried by a mirror closure of weight
     ``paint.facet`` with the exact Fresnel reflectance."""
-    if paint.slope > 0:
-        raise ValueError("closure fits of rough paints are not implemented yet (slope must be 0)")
-    basis = basis or smooth_basis()
+    basis = basis or basis_for(paint)
     views = _validate.positive_int(views, "views", 2)
     cos_view = np.linspace(0.0, 1.0, views)
     cos_light = np.linspace(np.cos(np.radians(88.0)), 1.0, light_polar)
     theta_l = np.arccos(cos_light)[:, None]
     phi = np.linspace(0.0, np.pi, azimuths)[None, :]
+    colour = [k for k, c in enumerate(basis) if not c.grey]
+    grey = [k for k, c in enumerate(basis) if c.grey]
     weights = np.zeros((len(basis), views, 3))
+    row_w = np.broadcast_to(np.cos(theta_l), (light_polar, azimuths)).ravel()
     num = den = 0.0
     for j, cv in enumerate(cos_view):
         theta_v = float(np.arccos(np.clip(cv, np.cos(np.radians(89.5)), 1.0)))
         target = paint.brdf(theta_l, theta_v, phi) * np.cos(theta_l)[..., None]  # (L, P, 3)
-        a = np.stack([c.evaluate(theta_l, theta_v, phi).ravel() for c in basis], axis=1)
-        row_w = np.broadcast_to(np.cos(theta_l), target.shape[:2]).ravel()
+        a = np.stack([c.evaluate(theta_l, theta_v, phi).ravel() for c in basis], axis=1) * row_w[:, None]
+        b = np.concatenate([target[..., ch].ravel() * row_w for ch in range(3)])
+        rows = a.shape[0]
+        big = np.zeros((3 * rows, 3 * len(colour) + len(grey)))
         for ch in range(3):
-            b = target[..., ch].ravel()
-            weights[:, j, ch] = nnls(a * row_w[:, None], b * row_w)
-            resid = (a @ weights[:, j, ch] - b) * row_w
-            num += np.sum(resid**2)
-            den += np.sum((b * row_w) ** 2)
-    return Fit(basis, cos_view, weights, paint.facet, float(np.sqrt(num / den)))
+            big[ch * rows : (ch + 1) * rows, ch * len(colour) : (ch + 1) * len(colour)] = a[:, colour]
+            big[ch * rows : (ch + 1) * rows, 3 * len(colour) :] = a[:, grey]
+        x = nnls(big, b)
+        for ch in range(3):
+            weights[colour, j, ch] = x[ch * len(colour) : (ch + 1) * len(colour)]
+            weights[grey, j, ch] = x[3 * len(colour) :]
+        num += np.sum((big @ x - b) ** 2)
+        den += np.sum(b**2)
+    mirror = paint.facet if paint.slope == 0 else 0.0
+    return Fit(basis, cos_view, weights, mirror, float(np.sqrt(num / den)))
 
 
 def save_weights(fitted: Fit, path) -> pathlib.Path:
@@ -155,10 +208,7 @@ def save_weights(fitted: Fit, path) -> pathlib.Path:
 
 def fit_for_lut(paint, lut_path):
     """The closure fit of a baked paint and its weights file beside the LUT
-    (``paintfit-<key>.exr`` next to ``paintlut-<key>.exr``); (None, None) for
-    rough paints, whose fit is not implemented yet."""
-    if paint.slope > 0:
-        return None, None
+    (``paintfit-<key>.exr`` next to ``paintlut-<key>.exr``)."""
     fitted = fit(paint)
     lut_path = pathlib.Path(lut_path)
     return fitted, save_weights(fitted, lut_path.with_name(lut_path.name.replace("paintlut-", "paintfit-")))

@@ -99,7 +99,7 @@ def test_background_job_reports_progress_and_can_be_cancelled(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == [job.path.name]  # nothing half-written
 
 
-def test_bake_wires_a_node_group_for_smooth_paints_only(material, tmp_path, monkeypatch):
+def test_bake_wires_a_node_group(material, tmp_path, monkeypatch):
     monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
     material.paint_lut.preset = "glossy_white"
     api.bake_material(material, resolution=(8, 6, 4))
@@ -113,4 +113,5 @@ def test_bake_wires_a_node_group_for_smooth_paints_only(material, tmp_path, monk
     rough.paint_lut.slope = 0.3
     api.bake_material(rough, resolution=(8, 6, 4))
     assert not rough.paint_lut.stale
-    assert not any(nd.type == "GROUP" for nd in rough.node_tree.nodes)  # rough fits: not implemented yet
+    group = next(nd for nd in rough.node_tree.nodes if nd.type == "GROUP").node_tree
+    assert any(nd.type == "BSDF_METALLIC" for nd in group.nodes)  # the facet lobe

@@ -37,10 +37,23 @@ def test_smooth_paints_fit_within_one_percent(name):
     assert fitted.mirror == paint.facet
 
 
-def test_rough_paints_are_not_fitted_yet(tmp_path):
-    with pytest.raises(ValueError, match="slope must be 0"):
-        closures.fit(lut.Paint(slope=0.3))
-    assert closures.fit_for_lut(lut.Paint(slope=0.3), tmp_path / "paintlut-x.exr") == (None, None)
+def test_rough_paints_get_metallic_lobes():
+    satin = closures.basis_for(lut.Paint(slope=0.25, n=1.4))
+    assert [c for c in satin if c.grey] == [closures.Closure("metallic", ior=1.4, roughness=0.5)]
+    matte = closures.basis_for(lut.Paint(slope=2.0, distribution="exponential"))
+    assert len([c for c in matte if c.grey]) == 4
+    fitted = closures.fit(lut.Paint(rho=0.5, slope=0.25))
+    grey = [k for k, c in enumerate(fitted.basis) if c.grey]
+    np.testing.assert_array_equal(fitted.weights[grey, :, 0], fitted.weights[grey, :, 2])  # one weight for all channels
+    assert fitted.mirror == 0.0
+
+
+def test_metallic_closure_without_shadowing_is_the_facet_term():
+    closure = closures.Closure("metallic", ior=1.5, roughness=0.5)
+    theta_l, theta_v, phi = np.radians([20.0, 40.0]), np.radians([30.0, 35.0]), np.array([0.2, 1.0])
+    facet = lut.models.facet_reflection(theta_l, theta_v, phi, n=1.5, slope=0.25, mueller=False) * np.cos(theta_l)
+    value = closure.evaluate(theta_l, theta_v, phi)
+    assert np.all(value <= facet) and np.all(value > 0.99 * facet)  # G is just below 1 here
 
 
 def test_weights_file_is_written_bottom_up(tmp_path):

@@ -77,15 +77,23 @@ def test_toon_closures_match_cycles(oracle, closure):
         assert got == pytest.approx(float(closure.evaluate(*geometry)), rel=1e-5, abs=1e-7)
 
 
-@pytest.mark.parametrize("name", ["glossy_white", "smooth single"])
-def test_smooth_paint_renders_within_two_percent(oracle, name, tmp_path, monkeypatch):
-    """The acceptance measure for smooth paints: rendered radiance against
-    Paint.brdf · cos θl for θl, θv <= 75° away from the mirror direction,
-    cos-weighted relative RMS <= 2%, through the add-on's own bake."""
+FIDELITY = {
+    "glossy white": (lut.preset("glossy_white"), 0.02),
+    "smooth single": (lut.Paint(rho=(0.8, 0.4, 0.1), single=0.3, g=0.3), 0.02),
+    "satin": (lut.Paint(rho=(0.8, 0.4, 0.1), single=0.3, g=0.3, slope=0.25), 0.05),
+    "matte": (lut.Paint(rho=(0.8, 0.4, 0.1), single=0.3, g=0.3, slope=2.0, distribution="exponential"), 0.05),
+}
+
+
+@pytest.mark.parametrize("name", list(FIDELITY))
+def test_paint_renders_within_target(oracle, name, tmp_path, monkeypatch):
+    """The acceptance measure: rendered radiance against Paint.brdf · cos θl
+    for θl, θv <= 75° away from the mirror direction, cos-weighted relative
+    RMS <= 2% (smooth) or 5% (rough), through the add-on's own bake."""
     import addon
     from addon import api
 
-    paint = lut.preset("glossy_white") if name == "glossy_white" else lut.Paint(rho=(0.8, 0.4, 0.1), single=0.3, g=0.3)
+    paint, target = FIDELITY[name]
     addon.register()
     try:
         monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
@@ -93,13 +101,13 @@ def test_smooth_paint_renders_within_two_percent(oracle, name, tmp_path, monkeyp
         material = oracle.material()
         api.bake_material(material, resolution=(8, 6, 4))
         num = den = 0.0
-        for tl in np.radians([0, 25, 50, 75]):
-            for tv in np.radians([5, 30, 55, 75]):
-                for phi in (0.6, 1.6, 2.8):
+        for tl in np.radians([0, 15, 30, 45, 60, 75]):
+            for tv in np.radians([5, 20, 35, 50, 65, 75]):
+                for phi in (0.4, 1.1, 1.9, 2.6, 3.1):
                     got = oracle.radiance(tl, tv, phi) / oracle.irradiance
                     ref = paint.brdf(tl, tv, phi) * math.cos(tl)
                     num += np.sum(((got - ref) * math.cos(tl)) ** 2)
                     den += np.sum((ref * math.cos(tl)) ** 2)
-        assert math.sqrt(num / den) < 0.02
+        assert math.sqrt(num / den) < target
     finally:
         addon.unregister()
