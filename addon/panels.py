@@ -7,6 +7,7 @@ import bpy
 
 def draw_settings(layout, material):
     settings = material.paint_lut
+    layout.prop(settings, "enabled")
     layout.prop(settings, "preset")
     col = layout.column(align=False)
     col.use_property_split = True

@@ -67,6 +67,9 @@ def _rgb(value, space):
 
 
 class PaintLUTSettings(bpy.types.PropertyGroup):
+    enabled: bpy.props.BoolProperty(
+        name="Use Paint LUT", default=False, description="Render this material as a Paint LUT paint",
+    )  # fmt: skip
     preset: bpy.props.EnumProperty(
         name="Preset", items=PRESET_ITEMS, default="CUSTOM", update=_preset_changed,
         description="One of the paper's three paints, or Custom",

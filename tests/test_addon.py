@@ -115,3 +115,37 @@ def test_bake_wires_a_node_group(material, tmp_path, monkeypatch):
     assert not rough.paint_lut.stale
     group = next(nd for nd in rough.node_tree.nodes if nd.type == "GROUP").node_tree
     assert any(nd.type == "BSDF_METALLIC" for nd in group.nodes)  # the facet lobe
+
+
+def test_new_material_is_baked_and_wired(tmp_path, monkeypatch):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
+    paint = lut.Paint(rho=(0.6, 0.3, 0.2), single=0.1, g=0.2, slope=0.1)
+    material = api.new_material("satin red", paint, resolution=(8, 6, 4))
+    assert material.paint_lut.enabled and not material.paint_lut.stale
+    assert api.paint_of(material) == paint
+    assert any(nd.type == "GROUP" for nd in material.node_tree.nodes)
+    carc = api.new_material("carc", lut.preset("green_carc"), resolution=(8, 6, 4))
+    assert carc.paint_lut.preset == "green_carc"
+    with pytest.raises(ValueError, match="spectral paints other than the presets"):
+        api.new_material("x", lut.Paint(rho="ColorChecker N Ohta/red"))
+
+
+def test_bake_scene_reports_baked_cached_unused(tmp_path, monkeypatch):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
+    scene = bpy.context.scene
+    materials = [bpy.data.materials.new(name) for name in ("a", "b", "unused")]
+    for i, material in enumerate(materials):
+        material.paint_lut.enabled = True
+        material.paint_lut.rho = (0.2 * (i + 1),) * 3
+    for material in materials[:2]:
+        mesh = bpy.data.meshes.new(material.name)
+        mesh.materials.append(material)
+        scene.collection.objects.link(bpy.data.objects.new(material.name, mesh))
+    small = {"resolution": (8, 6, 4)}
+    assert api.bake_scene(scene, **small) == {"a": "baked", "b": "baked", "unused": "unused"}
+    assert api.bake_scene(scene, **small) == {"a": "cached", "b": "cached", "unused": "unused"}
+    materials[1].paint_lut.g = 0.4
+    assert api.bake_scene(scene, **small) == {"a": "cached", "b": "baked", "unused": "unused"}
+    assert api.bake_scene(scene, force=True, **small)["a"] == "baked"
