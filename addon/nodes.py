@@ -11,7 +11,6 @@ roughness scaled by their (grey) weights.  Cycles only for now (issue 4)."""
 from __future__ import annotations
 
 import bpy
-import numpy as np
 
 from lut import closures
 
@@ -59,18 +58,12 @@ def build_group(name, fitted: closures.Fit, weights_path, n):
         tex.extension = "EXTEND"
         links.new(coord.outputs[0], tex.inputs["Vector"])
         if closure.grey:
-            # No colour input: scale by a Mix Shader factor, which clamps at
-            # 1, so a weight up to m is m copies of weight/m.
-            copies = max(1, int(np.ceil(fitted.weights[k].max() - 1e-9)))
-            scale = nodes.new("ShaderNodeMath")
-            scale.operation = "DIVIDE"
-            links.new(tex.outputs["Color"], scale.inputs[0])  # grey: every channel is the weight
-            scale.inputs[1].default_value = copies
+            # No colour input: scale by a Mix Shader factor (the fit keeps
+            # grey weights <= 1, where the factor clamps).
             lobe = nodes.new("ShaderNodeMixShader")
-            links.new(scale.outputs[0], lobe.inputs["Fac"])
+            links.new(tex.outputs["Color"], lobe.inputs["Fac"])  # grey: every channel is the weight
             links.new(_metallic(nodes, closure.ior, closure.roughness).outputs[0], lobe.inputs[2])
-            for _ in range(copies):
-                total = lobe if total is None else _add(nodes, links, total, lobe)
+            total = lobe if total is None else _add(nodes, links, total, lobe)
             continue
         bsdf = _closure_node(nodes, closure)
         links.new(tex.outputs["Color"], bsdf.inputs["Color"])

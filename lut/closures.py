@@ -158,7 +158,32 @@ class Fit:
     error: float
 
 
-def fit(paint, views=32, light_polar=24, azimuths=24, basis=None) -> Fit:
+#: Closures kept in a fit: render time grows with their number.  6 is the knee
+#: measured by scripts/render_cost.py and the fidelity tests (README).
+MAX_CLOSURES = 6
+
+
+def fit(paint, views=32, light_polar=24, azimuths=24, basis=None, max_closures=MAX_CLOSURES) -> Fit:
+    """As ``fit_all``, keeping at most ``max_closures`` closures: those that
+    carry the most of the fitted radiance (summed over views, channels and
+    light directions), refitted on their own."""
+    full = fit_all(paint, views, light_polar, azimuths, basis)
+    max_closures = _validate.positive_int(max_closures, "max_closures")
+    if len(full.basis) <= max_closures:
+        return full
+    cos_light = np.linspace(np.cos(np.radians(88.0)), 1.0, light_polar)
+    theta_l = np.arccos(cos_light)[:, None]
+    phi = np.linspace(0.0, np.pi, azimuths)[None, :]
+    energy = np.zeros(len(full.basis))
+    for j, cv in enumerate(full.cos_view):
+        theta_v = float(np.arccos(np.clip(cv, np.cos(np.radians(89.5)), 1.0)))
+        for k, c in enumerate(full.basis):
+            energy[k] += np.sum(c.evaluate(theta_l, theta_v, phi) * np.cos(theta_l)) * full.weights[k, j].sum()
+    keep = sorted(np.argsort(energy)[::-1][:max_closures])
+    return fit_all(paint, views, light_polar, azimuths, [full.basis[k] for k in keep])
+
+
+def fit_all(paint, views=32, light_polar=24, azimuths=24, basis=None) -> Fit:
     """Fit a paint's non-delta BRDF · cos θl, per view cosine, as a
     non-negative combination of ``basis`` closures (default ``basis_for``):
     one NNLS per view over the three channels together, coloured closures
@@ -188,13 +213,23 @@ def fit(paint, views=32, light_polar=24, azimuths=24, basis=None) -> Fit:
             big[ch * rows : (ch + 1) * rows, ch * len(colour) : (ch + 1) * len(colour)] = a[:, colour]
             big[ch * rows : (ch + 1) * rows, 3 * len(colour) :] = a[:, grey]
         x = nnls(big, b)
+        grey_w = x[3 * len(colour) :]
+        if np.any(grey_w > 1.0):
+            # A grey closure's weight is a Mix Shader factor, which clamps at
+            # 1 (weights above 1 only occur near grazing, where Cycles'
+            # shadowing darkens the lobe): cap them and refit the rest.
+            x[3 * len(colour) :] = np.minimum(grey_w, 1.0)
+            fixed = big[:, 3 * len(colour) :] @ x[3 * len(colour) :]
+            x[: 3 * len(colour)] = nnls(big[:, : 3 * len(colour)], b - fixed)
         for ch in range(3):
             weights[colour, j, ch] = x[ch * len(colour) : (ch + 1) * len(colour)]
             weights[grey, j, ch] = x[3 * len(colour) :]
         num += np.sum((big @ x - b) ** 2)
         den += np.sum(b**2)
+    # Closures with zero weight at every view cost render time for nothing.
+    used = [k for k in range(len(basis)) if weights[k].max() > 0]
     mirror = paint.facet if paint.slope == 0 else 0.0
-    return Fit(basis, cos_view, weights, mirror, float(np.sqrt(num / den)))
+    return Fit([basis[k] for k in used], cos_view, weights[used], mirror, float(np.sqrt(num / den)))
 
 
 def save_weights(fitted: Fit, path) -> pathlib.Path:

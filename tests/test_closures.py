@@ -34,6 +34,7 @@ def test_smooth_paints_fit_within_one_percent(name):
     fitted = closures.fit(paint)
     assert fitted.error < 0.01
     assert np.all(fitted.weights >= 0) and fitted.weights.shape == (len(fitted.basis), 32, 3)
+    assert np.all(fitted.weights.max(axis=(1, 2)) > 0)  # unused closures are dropped
     assert fitted.mirror == paint.facet
 
 
@@ -45,6 +46,7 @@ def test_rough_paints_get_metallic_lobes():
     fitted = closures.fit(lut.Paint(rho=0.5, slope=0.25))
     grey = [k for k, c in enumerate(fitted.basis) if c.grey]
     np.testing.assert_array_equal(fitted.weights[grey, :, 0], fitted.weights[grey, :, 2])  # one weight for all channels
+    assert fitted.weights[grey].max() <= 1.0  # a Mix Shader factor
     assert fitted.mirror == 0.0
 
 
@@ -62,3 +64,14 @@ def test_weights_file_is_written_bottom_up(tmp_path):
     oiio = lut.lutfile._oiio()
     pixels = oiio.ImageBuf(str(path)).get_pixels(oiio.FLOAT)
     np.testing.assert_allclose(pixels[-1], fitted.weights[0], rtol=1e-6)  # closure 0 in the bottom row
+
+
+def test_closure_budget_keeps_the_strongest():
+    paint = lut.preset("green_carc")
+    full = closures.fit_all(paint)
+    budget = closures.fit(paint, max_closures=4)
+    assert len(full.basis) > 4 and len(budget.basis) <= 4
+    assert set(budget.basis) <= set(full.basis)
+    assert budget.error < 2 * full.error  # the strongest closures carry most of the fit
+    with pytest.raises(ValueError, match="max_closures must be a whole number >= 1"):
+        closures.fit(paint, max_closures=0)

@@ -1,0 +1,81 @@
+"""Render cost of a Paint LUT material against a Principled BSDF (Cycles).
+
+    .venv/bin/python scripts/render_cost.py [--samples N] [--size PX]
+
+Renders a UV sphere lit by a Sun and a dim world at 256x256, once with a
+Principled BSDF and once with each preset's baked node group, and prints the
+time ratio (best of 3 renders after a warm-up)."""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
+
+import bpy  # noqa: E402
+
+import addon  # noqa: E402
+import lut  # noqa: E402
+from addon import api  # noqa: E402
+
+
+def scene(size, samples):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    sc = bpy.context.scene
+    sc.render.engine = "CYCLES"
+    sc.cycles.device = "CPU"
+    sc.cycles.samples = samples
+    sc.cycles.use_denoising = False
+    sc.render.resolution_x = sc.render.resolution_y = size
+    sc.render.filepath = str(pathlib.Path(tempfile.mkdtemp()) / "cost.png")
+    world = bpy.data.worlds.new("world")
+    sc.world = world
+    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.3
+    bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32)
+    sphere = bpy.context.object
+    bpy.ops.object.shade_smooth()
+    cam = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
+    cam.location = (0, -4, 0)
+    cam.rotation_euler = (1.5708, 0, 0)
+    sc.collection.objects.link(cam)
+    sc.camera = cam
+    sun = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
+    sun.rotation_euler = (0.6, 0.3, 0.0)
+    sc.collection.objects.link(sun)
+    return sc, sphere
+
+
+def timed(sc, repeat=3):
+    bpy.ops.render.render(write_still=False)  # warm-up (kernel and scene sync)
+    best = float("inf")
+    for _ in range(repeat):
+        start = time.perf_counter()
+        bpy.ops.render.render(write_still=False)
+        best = min(best, time.perf_counter() - start)
+    return best
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--samples", type=int, default=16)
+    parser.add_argument("--size", type=int, default=256)
+    args = parser.parse_args(argv)
+    addon.register()
+    sc, sphere = scene(args.size, args.samples)
+    principled = bpy.data.materials.new("principled")
+    sphere.data.materials.append(principled)
+    base = timed(sc)
+    print(f"Principled BSDF: {base:.3f} s ({args.size}x{args.size}, {args.samples} samples)")
+    for name in lut.PRESETS:
+        material = api.new_material(name, lut.preset(name))
+        sphere.data.materials[0] = material
+        t = timed(sc)
+        print(f"{name:13} {t:.3f} s  ratio {t / base:.2f}")
+
+
+if __name__ == "__main__":
+    main()
