@@ -18,8 +18,12 @@ GROUP_PREFIX = "Paint LUT"
 
 
 def _image(path):
+    """The weights image, read as data (Non-Color), referenced relative to
+    the .blend file when it is saved so a render farm finds it."""
     image = bpy.data.images.load(str(path), check_existing=False)
     image.colorspace_settings.name = "Non-Color"
+    if bpy.data.filepath:
+        image.filepath = bpy.path.relpath(str(path))
     return image
 
 

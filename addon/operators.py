@@ -13,7 +13,7 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
 
     bl_idname = "paint_lut.bake"
     bl_label = "Bake Paint"
-    bl_options = {"REGISTER"}
+    bl_options = {"REGISTER", "UNDO"}
 
     force: bpy.props.BoolProperty(name="Force", default=False, description="Bake even if a matching LUT exists")
 

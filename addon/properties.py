@@ -18,6 +18,11 @@ PRESET_ITEMS = [("CUSTOM", "Custom", "Paint given by the fields below")] + [
 
 _applying_preset = False
 
+# Blender 5.0 warns when a "//" path is stored in a FILE_PATH property that
+# does not declare this option.  It is checked on 5.0 only, so earlier
+# versions are not asked for it.
+_RELATIVE_PATH = {"PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (5, 0, 0) else set()
+
 
 def working_space() -> str:
     """The scene-linear working space of the open file, as a lut space name
@@ -51,6 +56,12 @@ def _preset_changed(self, context):
         self.facet = paint.facet
     finally:
         _applying_preset = False
+
+
+# Blender 5.0 warns when a "//" path is stored in a FILE_PATH property that
+# does not declare this option.  It is checked on 5.0 only, so earlier
+# versions are not asked for it.
+_RELATIVE_PATH = {"PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (5, 0, 0) else set()
 
 
 def _exact(value):
@@ -104,7 +115,9 @@ class PaintLUTSettings(bpy.types.PropertyGroup):
         name="Surface Reflection", default=1.0, min=0.0, max=1.0, update=_changed,
         description="Weight of the reflection by the surface itself",
     )  # fmt: skip
-    lut_path: bpy.props.StringProperty(name="LUT", subtype="FILE_PATH", description="The baked lookup table")
+    lut_path: bpy.props.StringProperty(
+        name="LUT", subtype="FILE_PATH", description="The baked lookup table", options=_RELATIVE_PATH,
+    )  # fmt: skip
     stale: bpy.props.BoolProperty(name="Needs Bake", default=True, description="The paint changed since the last bake")
 
     def to_paint(self, space: str | None = None) -> lut.Paint:

@@ -149,3 +149,15 @@ def test_bake_scene_reports_baked_cached_unused(tmp_path, monkeypatch):
     materials[1].paint_lut.g = 0.4
     assert api.bake_scene(scene, **small) == {"a": "cached", "b": "baked", "unused": "unused"}
     assert api.bake_scene(scene, force=True, **small)["a"] == "baked"
+
+
+def test_saved_files_reference_luts_relatively(tmp_path):
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "scene.blend"))
+    material = api.new_material("paint", lut.Paint(rho=0.5), resolution=(8, 6, 4))
+    assert material.paint_lut.lut_path.startswith("//paint_lut/paintlut-")
+    group = next(nd for nd in material.node_tree.nodes if nd.type == "GROUP").node_tree
+    image = next(nd.image for nd in group.nodes if nd.type == "TEX_IMAGE")
+    assert image.filepath.startswith("//paint_lut/paintfit-")
+    assert (tmp_path / "paint_lut").is_dir()
+    assert "UNDO" in addon.operators.PAINTLUT_OT_bake.bl_options
