@@ -10,7 +10,7 @@ import bpy
 import lut
 from lut import closures
 
-from . import nodes
+from . import nodes, properties
 from .properties import working_space
 
 #: LUTs go here, relative to the saved .blend file.
@@ -64,15 +64,8 @@ def set_paint(material, paint: lut.Paint) -> None:
             return
     if paint.spectral:
         raise ValueError("spectral paints other than the presets cannot be stored on a material yet; use RGB colours")
-    paint = paint.converted(working_space())
     settings.preset = "CUSTOM"
-    settings.n = paint.n
-    settings.rho = paint.rho
-    settings.single = paint.single
-    settings.g = paint.g
-    settings.slope = paint.slope
-    settings.distribution = paint.distribution.upper()
-    settings.facet = paint.facet
+    properties.set_fields(settings, paint.converted(working_space()))
 
 
 def new_material(name: str, paint: lut.Paint, **options):

@@ -79,11 +79,4 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
 CLASSES = (PAINTLUT_OT_bake,)
 
 
-def register():
-    for cls in CLASSES:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(CLASSES):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(CLASSES)

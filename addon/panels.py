@@ -27,8 +27,14 @@ def draw_settings(layout, material):
         layout.label(text=bpy.path.basename(settings.lut_path), icon="CHECKMARK")
 
 
-class MATERIAL_PT_paint_lut(bpy.types.Panel):
+class _PaintLUTPanel:
     bl_label = "Paint LUT"
+
+    def draw(self, context):
+        draw_settings(self.layout, context.material)
+
+
+class MATERIAL_PT_paint_lut(_PaintLUTPanel, bpy.types.Panel):
     bl_space_type = "PROPERTIES"
     bl_region_type = "WINDOW"
     bl_context = "material"
@@ -37,12 +43,8 @@ class MATERIAL_PT_paint_lut(bpy.types.Panel):
     def poll(cls, context):
         return getattr(context, "material", None) is not None
 
-    def draw(self, context):
-        draw_settings(self.layout, context.material)
 
-
-class NODE_PT_paint_lut(bpy.types.Panel):
-    bl_label = "Paint LUT"
+class NODE_PT_paint_lut(_PaintLUTPanel, bpy.types.Panel):
     bl_space_type = "NODE_EDITOR"
     bl_region_type = "UI"
     bl_category = "Paint LUT"
@@ -52,18 +54,8 @@ class NODE_PT_paint_lut(bpy.types.Panel):
         space = context.space_data
         return getattr(space, "tree_type", None) == "ShaderNodeTree" and getattr(context, "material", None) is not None
 
-    def draw(self, context):
-        draw_settings(self.layout, context.material)
-
 
 CLASSES = (MATERIAL_PT_paint_lut, NODE_PT_paint_lut)
 
 
-def register():
-    for cls in CLASSES:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(CLASSES):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(CLASSES)

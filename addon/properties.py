@@ -40,20 +40,24 @@ def _changed(self, context):
 
 
 def _preset_changed(self, context):
-    global _applying_preset
     self.stale = True
-    if self.preset == "CUSTOM":
-        return
-    paint = lut.preset(self.preset, working_space())
+    if self.preset != "CUSTOM":
+        set_fields(self, lut.preset(self.preset, working_space()))
+
+
+def set_fields(settings, paint: lut.Paint) -> None:
+    """Fill the physical fields from a paint (spectra shown as their RGB in
+    the paint's working space) without touching the preset choice."""
+    global _applying_preset
     _applying_preset = True
     try:
-        self.n = paint.n
-        self.rho = _rgb(paint.rho, paint.space)
-        self.single = _rgb(paint.single, paint.space)
-        self.g = paint.g
-        self.slope = paint.slope
-        self.distribution = paint.distribution.upper()
-        self.facet = paint.facet
+        settings.n = paint.n
+        settings.rho = _rgb(paint.rho, paint.space)
+        settings.single = _rgb(paint.single, paint.space)
+        settings.g = paint.g
+        settings.slope = paint.slope
+        settings.distribution = paint.distribution.upper()
+        settings.facet = paint.facet
     finally:
         _applying_preset = False
 
