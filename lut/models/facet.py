@@ -104,15 +104,6 @@ def facet_reflection(theta_i, theta_s, phi_s, *, n, slope, distribution="gaussia
     return _vectorize.evaluate(kernel, angles, mueller)
 
 
-def transmission_normal(k_i, k_t, n):
-    """Facet normal refracting k_i into k_t (paper Eqs. 31-32): n̂ ∝ k_i - n k_t,
-    signed so that n̂_z >= 0.  Returns (n̂, D) with D = |k_i - n k_t|."""
-    v = k_i - n * k_t
-    sign = np.where(v[..., 2] < 0.0, -1.0, 1.0)
-    h, d = geometry.unit_or(v * sign[..., None], np.array([0.0, 0.0, 1.0]))
-    return h, d
-
-
 def facet_transmission(theta_i, theta_t, phi_t, *, n, slope, distribution="gaussian", mueller=True):
     """Mueller BTDF [sr⁻¹] of refraction into the binder through the facets of
     an isotropic rough surface, paper Eq. 43:

@@ -277,18 +277,15 @@ def _prepare(theta, n, slope, distribution, nodes, entering):
     the ray's global s/p basis and the facet's internal one: A = diag(t_s,
     t_p)·R on entry; on exit its transpose, B = Rᵀ·diag(t_s, t_p)."""
     st = _facet_states(theta, n, slope, distribution, nodes, entering)
-    s_loc, p_ext, p_int = _local_basis(st["k"], st["k_in"], st["h"])
+    s_loc, _, p_int = _local_basis(st["k"], st["k_in"], st["h"])
     heading = st["k_in"][..., 2] < 0.0 if entering else st["k_in"][..., 2] > 0.0
     st["weight"] = np.where(heading, st["w"] * st["beam"], 0.0)
     st["depth"] = np.abs(st["k_in"][..., 2])
     st["s"], st["p"] = s_loc, p_int
-    s_g, p_g = geometry.sp_basis(st["k"])
-    jones = np.stack(
-        (
-            np.stack((st["t_s"] * dot(s_loc, s_g), st["t_s"] * dot(s_loc, p_g)), -1),
-            np.stack((st["t_p"] * dot(p_ext, s_g), st["t_p"] * dot(p_ext, p_g)), -1),
-        ),
-        -2,
+    # The crossing seen from the global s/p basis of k into the facet's own
+    # internal basis (R_out = identity): diag(t_s, t_p)·R.
+    jones = geometry.interface_jones(
+        st["k"], st["k_in"], st["h"], st["t_s"], st["t_p"], geometry.sp_basis(st["k"]), (s_loc, p_int)
     )
     # At φs = 0 the exit's global basis turns rigidly with the azimuth (θs > 0).
     st["J"] = jones if entering else np.swapaxes(jones, -1, -2)
