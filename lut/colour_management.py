@@ -1,5 +1,11 @@
-"""Colour: spectra, working spaces and the spectral-to-RGB integration, all
-through colour-science (no hand-typed matrices).
+"""Colour: spectra, working spaces and the spectral-to-RGB integration.
+
+Every number comes from colour-science (no hand-typed matrices), but the ones
+a bake needs are stored as data in ``lut.colour_data`` (made by
+``scripts/make_colour_data.py``; a test recomputes them), so baking presets
+and spectral paints does not import colour-science: Blender does not ship it
+and it would pull scipy into the extension.  colour-science is needed only to
+regenerate the data and to read spectra from its other datasets.
 
 RGB values are scene-linear in a named working space, with the names Blender
 uses: "Linear Rec.709" (default), "Linear Rec.2020", "ACEScg".  Spectra are
@@ -45,6 +51,34 @@ def working_space(name: str) -> str:
 @functools.lru_cache(maxsize=8)
 def spectral_weights(space: str = DEFAULT_SPACE) -> np.ndarray:
     """Matrix W (3, len(WAVELENGTHS)) with RGB = W @ values for a
+    reflectance-like spectrum (stored data; see ``compute_spectral_weights``)."""
+    from . import colour_data
+
+    weights = np.array(colour_data.SPECTRAL_WEIGHTS[working_space(space)], dtype=float)
+    weights.setflags(write=False)
+    return weights
+
+
+def rgb_to_rgb(source: str, target: str) -> np.ndarray:
+    """3x3 matrix converting linear RGB of one working space to another
+    (stored data; see ``compute_rgb_to_rgb``)."""
+    from . import colour_data
+
+    return np.array(colour_data.RGB_TO_RGB[f"{working_space(source)} -> {working_space(target)}"], dtype=float)
+
+
+def compute_rgb_to_rgb(source: str, target: str) -> np.ndarray:
+    """colour-science's RGB-to-RGB matrix with Bradford adaptation."""
+    colour = _colour()
+    return colour.matrix_RGB_to_RGB(
+        colour.RGB_COLOURSPACES[WORKING_SPACES[working_space(source)]],
+        colour.RGB_COLOURSPACES[WORKING_SPACES[working_space(target)]],
+        chromatic_adaptation_transform="Bradford",
+    )
+
+
+def compute_spectral_weights(space: str = DEFAULT_SPACE) -> np.ndarray:
+    """Matrix W (3, len(WAVELENGTHS)) with RGB = W @ values for a
     reflectance-like spectrum sampled at WAVELENGTHS: CIE 1931 2° colour
     matching functions times D65, normalized so that a flat spectrum of 1 has
     Y = 1, then XYZ -> working-space RGB with Bradford adaptation from D65:
@@ -63,9 +97,7 @@ def spectral_weights(space: str = DEFAULT_SPACE) -> np.ndarray:
     to_rgb = colour.XYZ_to_RGB(
         np.eye(3), WORKING_SPACES[space], illuminant=white, chromatic_adaptation_transform="Bradford"
     ).T  # columns: RGB of the X, Y, Z unit vectors
-    weights = to_rgb @ xyz
-    weights.setflags(write=False)
-    return weights
+    return to_rgb @ xyz
 
 
 def spectrum_to_rgb(values, space: str = DEFAULT_SPACE) -> np.ndarray:
@@ -158,7 +190,18 @@ def _is_number(text):
 
 
 def _dataset(name: str):
-    colour = _colour()
+    from . import colour_data
+
+    if name in colour_data.SPECTRA:
+        wavelengths, values = colour_data.SPECTRA[name]
+        return np.array(wavelengths, dtype=float), np.array(values, dtype=float)
+    try:
+        colour = _colour()
+    except ImportError:
+        raise ValueError(
+            f"spectrum {name!r} needs colour-science, which is not installed; stored without it: "
+            f"{', '.join(sorted(colour_data.SPECTRA))}"
+        ) from None
     collection, _, entry = name.partition("/")
     sds = colour.SDS_COLOURCHECKERS.get(collection)
     if sds is None or entry not in sds:

@@ -65,6 +65,32 @@ def _to_image(table: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(table.reshape(n_p * n_d, n_u, c), dtype=np.float32)
 
 
+@contextlib.contextmanager
+def atomic_target(path):
+    """Write a file atomically: yields a temporary path in the same directory
+    (same suffix, so writers that go by the extension work) that is renamed
+    onto ``path`` when the block succeeds and removed when it fails, so an
+    interrupted write never leaves a partial file and never loses the old one."""
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=f".partial{path.suffix}")
+    os.close(fd)
+    try:
+        yield tmp
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            os.remove(tmp)
+
+
+def atomic_write_bytes(path, data: bytes) -> pathlib.Path:
+    """Write bytes to ``path`` atomically (``atomic_target``)."""
+    with atomic_target(path) as tmp, open(tmp, "wb") as fh:
+        fh.write(data)
+    return pathlib.Path(path)
+
+
 def write_exr(path, image: np.ndarray, attributes: dict) -> pathlib.Path:
     """Write a float32 (height, width, 3) image with string/int attributes
     atomically: to a temporary file in the same directory, renamed into
@@ -79,9 +105,7 @@ def write_exr(path, image: np.ndarray, attributes: dict) -> pathlib.Path:
     spec.attribute("oiio:ColorSpace", "Non-Color")
     for key, value in attributes.items():
         spec.attribute(key, value)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".partial.exr")
-    os.close(fd)
-    try:
+    with atomic_target(path) as tmp:
         out = oiio.ImageOutput.create(tmp)
         if out is None or not out.open(tmp, spec):
             raise OSError(f"cannot write {tmp}: {oiio.geterror()}")
@@ -89,11 +113,6 @@ def write_exr(path, image: np.ndarray, attributes: dict) -> pathlib.Path:
         out.close()
         if not ok:
             raise OSError(f"cannot write {tmp}: {oiio.geterror()}")
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            os.remove(tmp)
     return path
 
 

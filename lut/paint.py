@@ -197,22 +197,16 @@ class Paint:
 
     def converted(self, space: str) -> Paint:
         """The same paint with results in another working space (RGB colour
-        values converted linearly with colour-science, Bradford adaptation)."""
+        values converted linearly, Bradford adaptation: colour-science's matrices)."""
         space = cm.working_space(space)
         if space == self.space:
             return self
-        colour = cm._colour()
+        matrix = cm.rgb_to_rgb(self.space, space)
 
         def conv(v):
             if isinstance(v, cm.Spectrum):
                 return v
-            rgb = colour.RGB_to_RGB(
-                np.array(v),
-                cm.WORKING_SPACES[self.space],
-                cm.WORKING_SPACES[space],
-                chromatic_adaptation_transform="Bradford",
-            )
-            return tuple(float(x) for x in np.clip(rgb, 0.0, 1.0))
+            return tuple(float(x) for x in np.clip(matrix @ np.array(v), 0.0, 1.0))
 
         return dataclasses.replace(self, rho=conv(self.rho), single=conv(self.single), space=space)
 
