@@ -1,0 +1,171 @@
+"""Build the Blender extension zip: dist/paint_lut-<version>.zip.
+
+    .venv/bin/python scripts/build_extension.py [--output-dir dist] [--blender PATH]
+
+The zip holds the add-on (addon/*.py, relative imports) with the repository's
+blender_manifest.toml, and the library as a wheel of its own
+(wheels/paint_lut-<version>-py3-none-any.whl, package ``lut``): Blender
+installs bundled wheels into the extensions' shared site-packages, so the
+installed add-on imports ``lut`` exactly as the repository's tests do.
+
+The one wheel is pure Python and serves Linux, Windows and macOS alike: at run
+time lut needs only numpy and OpenImageIO, which Blender 5.0 ships, and its
+colour numbers are stored data (lut/colour_data.py), so neither
+colour-science nor scipy (per-platform wheels) is bundled.
+
+The zip is built and validated by Blender's own extension builder: ``blender
+--command extension build`` when a Blender executable is given (or on PATH),
+otherwise the same builder script (blender_ext.py) from the pip bpy module."""
+
+from __future__ import annotations
+
+import argparse
+import base64
+import hashlib
+import importlib.util
+import pathlib
+import shutil
+import subprocess
+import sys
+import tempfile
+import tomllib
+import zipfile
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+#: zip entries get this fixed time, so the same sources give the same wheel.
+EPOCH = (1980, 1, 1, 0, 0, 0)
+
+
+def project() -> dict:
+    return tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]
+
+
+def manifest() -> dict:
+    return tomllib.loads((ROOT / "blender_manifest.toml").read_text())
+
+
+def wheel_name() -> str:
+    meta = project()
+    return f"{meta['name'].replace('-', '_')}-{meta['version']}-py3-none-any.whl"
+
+
+def check_versions() -> None:
+    """The manifest, pyproject and lut.__version__ must agree, and the
+    manifest must list the wheel this script writes."""
+    import lut
+
+    meta, man = project(), manifest()
+    versions = {"pyproject.toml": meta["version"], "blender_manifest.toml": man["version"], "lut": lut.__version__}
+    if len(set(versions.values())) != 1:
+        raise SystemExit(f"error: versions differ: {versions}")
+    if man.get("wheels") != [f"./wheels/{wheel_name()}"]:
+        raise SystemExit(f"error: blender_manifest.toml must list wheels = ['./wheels/{wheel_name()}']")
+
+
+def _add(archive: zipfile.ZipFile, name: str, data: bytes, record: list) -> None:
+    info = zipfile.ZipInfo(name, EPOCH)
+    info.compress_type = zipfile.ZIP_DEFLATED
+    info.external_attr = 0o644 << 16
+    archive.writestr(info, data)
+    digest = base64.urlsafe_b64encode(hashlib.sha256(data).digest()).rstrip(b"=").decode()
+    record.append(f"{name},sha256={digest},{len(data)}")
+
+
+def build_wheel(directory: pathlib.Path) -> pathlib.Path:
+    """Write the pure-Python wheel of ``lut`` (PEP 427) into ``directory``."""
+    meta = project()
+    dist_info = f"{meta['name'].replace('-', '_')}-{meta['version']}.dist-info"
+    path = directory / wheel_name()
+    record: list[str] = []
+    sources = sorted(p for p in (ROOT / "lut").rglob("*.py") if "__pycache__" not in p.parts)
+    metadata = [
+        "Metadata-Version: 2.1",
+        f"Name: {meta['name']}",
+        f"Version: {meta['version']}",
+        f"Summary: {meta['description']}",
+        f"License: {meta['license']['text']}",
+        f"Requires-Python: {meta['requires-python']}",
+        *(f"Requires-Dist: {dep}" for dep in meta["dependencies"]),
+    ]
+    wheel = ["Wheel-Version: 1.0", "Generator: paint-lut scripts/build_extension.py", "Root-Is-Purelib: true"]
+    wheel.append("Tag: py3-none-any")
+    with zipfile.ZipFile(path, "w") as archive:
+        for source in sources:
+            _add(archive, source.relative_to(ROOT).as_posix(), source.read_bytes(), record)
+        _add(archive, f"{dist_info}/METADATA", ("\n".join(metadata) + "\n").encode(), record)
+        _add(archive, f"{dist_info}/WHEEL", ("\n".join(wheel) + "\n").encode(), record)
+        record.append(f"{dist_info}/RECORD,,")
+        info = zipfile.ZipInfo(f"{dist_info}/RECORD", EPOCH)
+        info.external_attr = 0o644 << 16
+        archive.writestr(info, "\n".join(record) + "\n")
+    return path
+
+
+def stage(directory: pathlib.Path) -> pathlib.Path:
+    """The extension's source folder: add-on modules, manifest and wheel."""
+    source = directory / "paint_lut"
+    (source / "wheels").mkdir(parents=True)
+    for module in sorted((ROOT / "addon").glob("*.py")):
+        shutil.copy2(module, source / module.name)
+    shutil.copy2(ROOT / "blender_manifest.toml", source / "blender_manifest.toml")
+    build_wheel(source / "wheels")
+    return source
+
+
+def builder_script() -> pathlib.Path:
+    """blender_ext.py of the installed bpy module (Blender's extension builder)."""
+    spec = importlib.util.find_spec("bpy")
+    if spec is None or not spec.submodule_search_locations:
+        raise SystemExit("error: no Blender: pass --blender PATH or install the bpy module (scripts/bootstrap.sh)")
+    for location in spec.submodule_search_locations:
+        found = sorted(pathlib.Path(location).glob("*/scripts/addons_core/bl_pkg/cli/blender_ext.py"))
+        if found:
+            return found[-1]
+    raise SystemExit("error: the bpy module has no extension builder (blender_ext.py)")
+
+
+def builder(blender: str | None) -> list[str]:
+    """The command that runs Blender's extension builder."""
+    blender = blender or shutil.which("blender")
+    if blender:
+        return [blender, "--factory-startup", "--command", "extension"]
+    return [sys.executable, str(builder_script())]
+
+
+def run(command: list[str]) -> None:
+    done = subprocess.run(command, capture_output=True, text=True)
+    if done.returncode != 0:
+        raise SystemExit(f"error: {' '.join(command[-4:])} failed:\n{done.stdout}{done.stderr}")
+
+
+def build(output_dir, blender: str | None = None) -> pathlib.Path:
+    """Build and validate the extension zip; returns its path."""
+    check_versions()
+    output_dir = pathlib.Path(output_dir).resolve()
+    output_dir.mkdir(parents=True, exist_ok=True)
+    target = output_dir / f"{manifest()['id']}-{manifest()['version']}.zip"
+    command = builder(blender)
+    with tempfile.TemporaryDirectory(prefix="paint_lut_build") as tmp:
+        source = stage(pathlib.Path(tmp))
+        # Build next to the staging folder, then move into place: a failed
+        # build never replaces a good zip.
+        partial = pathlib.Path(tmp) / target.name
+        run([*command, "build", "--source-dir", str(source), "--output-filepath", str(partial)])
+        run([*command, "validate", str(partial)])
+        shutil.move(partial, target)
+    return target
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--output-dir", default=str(ROOT / "dist"), help="where the zip goes (default dist/)")
+    parser.add_argument("--blender", help="Blender executable (default: blender on PATH, else the bpy module)")
+    args = parser.parse_args(argv)
+    print(build(args.output_dir, args.blender))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

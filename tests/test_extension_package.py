@@ -1,0 +1,130 @@
+"""The extension zip (scripts/build_extension.py): built and validated by
+Blender's own builder, then installed into a clean Blender user directory
+with no network, where a preset is baked and rendered."""
+
+import importlib.util
+import os
+import pathlib
+import subprocess
+import sys
+import textwrap
+import tomllib
+import zipfile
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+_spec = importlib.util.spec_from_file_location("build_extension", ROOT / "scripts" / "build_extension.py")
+build_extension = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(build_extension)
+
+
+@pytest.fixture(scope="module")
+def package(tmp_path_factory):
+    return build_extension.build(tmp_path_factory.mktemp("dist"))
+
+
+def test_zip_holds_the_add_on_manifest_and_lut_wheel(package):
+    with zipfile.ZipFile(package) as archive:
+        names = set(archive.namelist())
+        manifest = tomllib.loads(archive.read("blender_manifest.toml").decode())
+        wheel = manifest["wheels"][0].removeprefix("./")
+        assert {"__init__.py", "api.py", "nodes.py", "properties.py", wheel} <= names
+        assert not any(name.startswith(("lut/", "tests/", "scripts/")) or "__pycache__" in name for name in names)
+        with zipfile.ZipFile(archive.open(wheel)) as inner:
+            files = set(inner.namelist())
+    assert {"lut/__init__.py", "lut/colour_data.py", "lut/models/rough.py"} <= files
+    assert not any(f.startswith(("addon/", "tests/")) for f in files)
+    record = next(f for f in files if f.endswith(".dist-info/RECORD"))
+    assert record.startswith("paint_lut-0.1.0.dist-info/")
+
+
+def test_wheel_is_reproducible(tmp_path):
+    a = build_extension.build_wheel(tmp_path)
+    first = a.read_bytes()
+    a.unlink()
+    assert build_extension.build_wheel(tmp_path).read_bytes() == first
+
+
+def _validate(source):
+    command = [*build_extension.builder(None), "validate", str(source)]
+    return subprocess.run(command, capture_output=True, text=True)
+
+
+def test_manifest_passes_blenders_validator(tmp_path):
+    source = build_extension.stage(tmp_path)
+    done = _validate(source)
+    assert done.returncode == 0, done.stdout + done.stderr
+
+
+def test_validator_rejects_a_bad_manifest(tmp_path):
+    """The validator is really consulted: a malformed version fails it."""
+    source = build_extension.stage(tmp_path)
+    manifest = source / "blender_manifest.toml"
+    manifest.write_text(manifest.read_text().replace('"4.2.0"', '"4.2"'))
+    done = _validate(source)
+    assert done.returncode != 0
+    assert "blender_version_min" in done.stdout + done.stderr
+
+
+def test_manifest_and_versions_agree():
+    build_extension.check_versions()  # raises SystemExit on a mismatch
+
+
+INSTALLED = textwrap.dedent(
+    """
+    import importlib, math, sys
+    sys.path.insert(0, {tests!r})
+    from blender_oracle import Oracle  # test harness only; not the add-on
+    oracle = Oracle()  # factory settings first: they would reset the preferences
+    import bpy
+    result = bpy.ops.extensions.package_install_files(
+        filepath={zip!r}, repo="user_default", enable_on_install=True
+    )
+    assert result == {{"FINISHED"}}, result
+    import lut
+    api = importlib.import_module("bl_ext.user_default.paint_lut.api")
+    material = bpy.data.materials.new("paint")
+    material.paint_lut.preset = "glossy_red"
+    material.paint_lut.enabled = True
+    bpy.ops.wm.save_as_mainfile(filepath={blend!r})
+    api.bake_material(material)
+    oracle.plane.data.materials.clear()
+    oracle.plane.data.materials.append(material)
+    rendered = oracle.brdf(0.5, 0.7, 1.2)
+    model = lut.preset("glossy_red").brdf(0.5, 0.7, 1.2)
+    print("LUT_FROM", lut.__file__)
+    print("ADDON_FROM", api.__file__)
+    print("LUT_PATH", material.paint_lut.lut_path)
+    print("RENDERED", *rendered)
+    print("MODEL", *model)
+    """
+)
+
+
+def test_installs_offline_into_a_clean_user_directory_and_renders(package, tmp_path):
+    resources = tmp_path / "blender_user"
+    code = INSTALLED.format(tests=str(ROOT / "tests"), zip=str(package), blend=str(tmp_path / "scene.blend"))
+    env = {k: v for k, v in os.environ.items() if k not in {"PYTHONPATH", "BLENDER_USER_SCRIPTS"}}
+    env.update(
+        BLENDER_USER_RESOURCES=str(resources),
+        no_proxy="*",
+        http_proxy="http://0.0.0.0:9",
+        https_proxy="http://0.0.0.0:9",
+    )
+    # Run outside the repository so that `lut` can only come from the extension's wheel.
+    done = subprocess.run(
+        [sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=600
+    )
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    out = dict(
+        line.split(" ", 1) for line in done.stdout.splitlines() if line.split(" ", 1)[0].isupper() and " " in line
+    )
+    assert pathlib.Path(out["LUT_FROM"]).is_relative_to(resources)
+    assert pathlib.Path(out["ADDON_FROM"]).is_relative_to(resources / "extensions" / "user_default" / "paint_lut")
+    assert out["LUT_PATH"].startswith("//paint_lut/")
+    assert (tmp_path / out["LUT_PATH"][2:]).exists()
+    rendered = [float(v) for v in out["RENDERED"].split()]
+    model = [float(v) for v in out["MODEL"].split()]
+    for r, m in zip(rendered, model, strict=True):
+        assert abs(r - m) <= 0.05 * max(model), (rendered, model)
