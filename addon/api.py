@@ -77,28 +77,54 @@ def new_material(name: str, paint: lut.Paint, **options):
     return material
 
 
-def bake_scene(scene, force=False, **options) -> dict:
-    """Bake the paint materials (those with Use Paint LUT) of the file as the
-    scene needs them.  Returns {material name: status}: "baked" (computed),
-    "cached" (up to date, nothing computed), "unused" (not on any object in
-    the scene, skipped) or "failed: <reason>"."""
-    used = {slot.material for obj in scene.objects for slot in obj.material_slots if slot.material is not None}
+def used_materials(scenes) -> set:
+    """The materials on the objects of ``scenes``."""
+    return {slot.material for scene in scenes for obj in scene.objects for slot in obj.material_slots if slot.material}
+
+
+def is_current(material, paint, **options) -> bool:
+    """Whether a material's bake is up to date: not stale, wired, and its LUT
+    and closure weights on disk are readable and verified (a corrupted or
+    missing file means a rebake, not a failure)."""
+    settings = material.paint_lut
+    if settings.stale or not settings.lut_path:
+        return False
+    path = lut.lut_path(paint, lut_directory(), **options)
+    weights = path.with_name(path.name.replace("paintlut-", "paintfit-"))
+    if pathlib.Path(bpy.path.abspath(settings.lut_path)) != path:
+        return False
+    try:
+        lut.load_lut(path)
+        lut.lutfile.read_exr(weights)
+    except lut.LUTError:
+        return False
+    return nodes.group_of(material) is not None
+
+
+def bake_materials(used, force=False, **options) -> dict:
+    """Bake the paint materials (those with Use Paint LUT) of the file that
+    are in ``used``.  Returns {material name: status}: "baked" (computed),
+    "cached" (up to date, nothing computed), "unused" (skipped) or
+    "failed: <reason>" (the material is left as it was)."""
     status = {}
     for material in bpy.data.materials:
-        settings = material.paint_lut
-        if not settings.enabled:
+        if not material.paint_lut.enabled:
             continue
         if material not in used:
             status[material.name] = "unused"
             continue
         try:
             paint = paint_of(material)
-            cached = not force and not settings.stale and lut.lut_path(paint, lut_directory(), **options).exists()
-            if cached and settings.lut_path:
+            if not force and is_current(material, paint, **options):
                 status[material.name] = "cached"
                 continue
             bake_material(material, force=force, **options)
             status[material.name] = "baked"
-        except (ValueError, OSError) as exc:
+        except (ValueError, OSError, RuntimeError) as exc:
             status[material.name] = f"failed: {exc}"
     return status
+
+
+def bake_scene(scene, force=False, **options) -> dict:
+    """Bake the paint materials the scene's objects use (``bake_materials``)."""
+    return bake_materials(used_materials([scene]), force=force, **options)

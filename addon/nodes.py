@@ -113,6 +113,14 @@ def _add(nodes, links, a, b):
     return add
 
 
+def group_of(material):
+    """The material's Paint LUT group node (None when it has none)."""
+    tree = material.node_tree
+    if tree is None:
+        return None
+    return next((nd for nd in tree.nodes if nd.type == "GROUP" and nd.name == GROUP_PREFIX and nd.node_tree), None)
+
+
 def wire(material, group):
     """Use the group as the material's surface (a group node into the output)."""
     nodes, links = material.node_tree.nodes, material.node_tree.links

@@ -162,6 +162,25 @@ def _open(path):
     return inp, header
 
 
+def read_exr(path) -> np.ndarray:
+    """The float pixels (height, width, channels) of any EXR image, finite
+    values required (closure weights files); raises LUTError."""
+    oiio = _oiio()
+    path = pathlib.Path(path)
+    if not path.is_file():
+        raise LUTError(f"{path}: no such file")
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise LUTError(f"{path}: not a readable EXR image (truncated or corrupt?): {oiio.geterror()}")
+    try:
+        pixels = inp.read_image(oiio.FLOAT)
+    finally:
+        inp.close()
+    if pixels is None or np.ndim(pixels) != 3 or not np.all(np.isfinite(pixels)):
+        raise LUTError(f"{path}: pixel data cannot be read or is not finite: {oiio.geterror()}")
+    return np.asarray(pixels)
+
+
 def read_header(path) -> dict:
     """The header of a LUT file (checks the format version, not the pixels):
     meta, meta_json, key, hash and size (width, height, channels)."""
