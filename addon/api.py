@@ -30,17 +30,20 @@ def paint_of(material) -> lut.Paint:
     return material.paint_lut.to_paint(working_space())
 
 
-def store_result(material, paint, path, fitted=None, weights=None) -> None:
+def store_result(material, paint, path, fits=None) -> None:
     """Record a finished bake on the material (path relative to the .blend
-    when it is saved), build and wire its node group when there is a closure
-    fit, and clear the stale flag."""
+    when it is saved), build and wire its node groups (one per render
+    engine) from ``fits`` ({target: (Fit, weights path)}), and clear the
+    stale flag."""
     settings = material.paint_lut
     settings.lut_path = bpy.path.relpath(str(path)) if bpy.data.filepath else str(path)
-    if fitted is not None:
-        group = nodes.build_group(
-            f"{nodes.GROUP_PREFIX} {material.name}", fitted, weights, float(paint.index_at(589.3))
-        )
-        nodes.wire(material, group)
+    if fits:
+        n = float(paint.index_at(589.3))
+        groups = {
+            target: nodes.build_group(nodes.group_name(material, target), fitted, weights, n)
+            for target, (fitted, weights) in fits.items()
+        }
+        nodes.wire(material, groups)
     settings.stale = False
 
 
@@ -49,7 +52,7 @@ def bake_material(material, force=False, **options) -> pathlib.Path:
     wired into the material's node tree as a node group."""
     paint = paint_of(material)
     path = lut.bake(paint, lut_directory(), force=force, **options)
-    store_result(material, paint, path, *closures.fit_for_lut(paint, path))
+    store_result(material, paint, path, closures.fit_for_lut(paint, path, exact_metallic=nodes.EXACT_METALLIC))
     material.paint_lut.enabled = True
     return path
 
@@ -90,15 +93,15 @@ def is_current(material, paint, **options) -> bool:
     if settings.stale or not settings.lut_path:
         return False
     path = lut.lut_path(paint, lut_directory(), **options)
-    weights = path.with_name(path.name.replace("paintlut-", "paintfit-"))
     if pathlib.Path(bpy.path.abspath(settings.lut_path)) != path:
         return False
     try:
         lut.load_lut(path)
-        lut.lutfile.read_exr(weights)
+        for target in closures.TARGETS:
+            lut.lutfile.read_exr(closures.weights_path(path, target))
     except lut.LUTError:
         return False
-    return nodes.group_of(material) is not None
+    return all(nodes.group_of(material, target) is not None for target in closures.TARGETS)
 
 
 def bake_materials(used, force=False, **options) -> dict:

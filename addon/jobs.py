@@ -16,14 +16,15 @@ class Cancelled(Exception):
 
 class BakeJob:
     """Bake one paint on a thread.  ``progress`` (0..1), ``done``,
-    ``path`` (on success), ``error`` (a message) and ``cancel()``."""
+    ``path`` and ``fits`` (on success: lut.closures.fit_for_lut's),
+    ``error`` (a message) and ``cancel()``."""
 
-    def __init__(self, paint: lut.Paint, directory, **options):
+    def __init__(self, paint: lut.Paint, directory, exact_metallic=True, **options):
         self.paint, self.directory, self.options = paint, directory, options
+        self.exact_metallic = exact_metallic
         self.progress = 0.0
         self.path = None
-        self.fit = None
-        self.weights = None
+        self.fits = None
         self.error = None
         self._cancel = threading.Event()
         self._thread = threading.Thread(target=self._run, name="paint-lut-bake", daemon=True)
@@ -55,11 +56,7 @@ class BakeJob:
     def _run(self):
         try:
             path = lut.bake(self.paint, self.directory, progress=self._progress, **self.options)
-            if self.paint.slope == 0:  # closure fits of rough paints are not implemented yet
-                self.fit = closures.fit(self.paint)
-                self.weights = closures.save_weights(
-                    self.fit, path.with_name(path.name.replace("paintlut-", "paintfit-"))
-                )
+            self.fits = closures.fit_for_lut(self.paint, path, exact_metallic=self.exact_metallic)
             self.path = path
             self.progress = 1.0
         except Cancelled:

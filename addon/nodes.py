@@ -6,7 +6,10 @@ row k, and sums the weighted closures; the smooth interface's mirror
 reflection is a Metallic BSDF (physical conductor, IOR n, no extinction,
 roughness 0: the exact dielectric Fresnel mirror in Blender 5.0) scaled by the
 facet weight, and rough paints' facet lobes are Metallic BSDFs of Beckmann
-roughness scaled by their (grey) weights.  Cycles only for now (issue 4)."""
+roughness (or, for EEVEE and Blender 4.2-4.5, Principled GGX lobes) scaled by
+their (grey) weights.  A material gets one group per
+render engine, each into a Material Output targeted at it (Cycles, EEVEE:
+lut.closures.TARGETS)."""
 
 from __future__ import annotations
 
@@ -15,6 +18,14 @@ import bpy
 from lut import closures
 
 GROUP_PREFIX = "Paint LUT"
+
+#: The Metallic BSDF's physical conductor Fresnel is the exact dielectric
+#: Fresnel for extinction 0 from Blender 5.0 on; 4.3-4.5 use an approximate
+#: conductor Fresnel (1.29-1.50x off for k = 0) and 4.2 has no Metallic BSDF.
+#: There the facet lobes are Principled BSDFs with a black base (exact
+#: dielectric Fresnel, GGX: lut.closures' "ggx" kind, fitted as such), as in
+#: every EEVEE group, and the mirror is a Principled BSDF of roughness 0.
+EXACT_METALLIC = bpy.app.version >= (5, 0, 0)
 
 
 def _image(path):
@@ -66,20 +77,32 @@ def build_group(name, fitted: closures.Fit, weights_path, n):
             # grey weights <= 1, where the factor clamps).
             lobe = nodes.new("ShaderNodeMixShader")
             links.new(tex.outputs["Color"], lobe.inputs["Fac"])  # grey: every channel is the weight
-            links.new(_metallic(nodes, closure.ior, closure.roughness).outputs[0], lobe.inputs[2])
+            make = _metallic if closure.kind == "metallic" else _principled_specular
+            links.new(make(nodes, closure.ior, closure.roughness).outputs[0], lobe.inputs[2])
             total = lobe if total is None else _add(nodes, links, total, lobe)
             continue
         bsdf = _closure_node(nodes, closure)
         links.new(tex.outputs["Color"], bsdf.inputs["Color"])
         total = bsdf if total is None else _add(nodes, links, total, bsdf)
     if fitted.mirror > 0:
-        mirror = _metallic(nodes, n, 0.0)
+        mirror = (_metallic if EXACT_METALLIC else _principled_specular)(nodes, n, 0.0)
         scaled = nodes.new("ShaderNodeMixShader")
         scaled.inputs["Fac"].default_value = fitted.mirror
         links.new(mirror.outputs[0], scaled.inputs[2])  # fac·mirror + (1 - fac)·nothing
         total = _add(nodes, links, total, scaled)
     links.new(total.outputs[0], out.inputs["Shader"])
     return group
+
+
+def _principled_specular(nodes, n, roughness):
+    """Principled BSDF with a black base and single-scatter GGX: its specular
+    layer alone, dielectric Fresnel of IOR n (Blender 4.2-4.5)."""
+    node = nodes.new("ShaderNodeBsdfPrincipled")
+    node.distribution = "GGX"
+    node.inputs["Base Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    node.inputs["IOR"].default_value = n
+    node.inputs["Roughness"].default_value = roughness
+    return node
 
 
 def _metallic(nodes, n, roughness):
@@ -113,22 +136,45 @@ def _add(nodes, links, a, b):
     return add
 
 
-def group_of(material):
-    """The material's Paint LUT group node (None when it has none)."""
+def group_name(material, target):
+    """The node group of a material's paint for a render engine."""
+    return f"{GROUP_PREFIX} {material.name}" + ("" if target == "CYCLES" else f" {target.title()}")
+
+
+def _node_name(target):
+    return GROUP_PREFIX if target == "CYCLES" else f"{GROUP_PREFIX} {target.title()}"
+
+
+def group_of(material, target="CYCLES"):
+    """The material's Paint LUT group node for a render engine (None when it has none)."""
     tree = material.node_tree
     if tree is None:
         return None
-    return next((nd for nd in tree.nodes if nd.type == "GROUP" and nd.name == GROUP_PREFIX and nd.node_tree), None)
+    name = _node_name(target)
+    return next((nd for nd in tree.nodes if nd.type == "GROUP" and nd.name == name and nd.node_tree), None)
 
 
-def wire(material, group):
-    """Use the group as the material's surface (a group node into the output)."""
+def wire(material, groups):
+    """Use the groups ({target: node group}) as the material's surface: a
+    group node into a Material Output per render engine ('CYCLES', 'EEVEE').
+    An existing output for all engines becomes Cycles' output."""
     nodes, links = material.node_tree.nodes, material.node_tree.links
-    node = next((nd for nd in nodes if nd.type == "GROUP" and nd.name == GROUP_PREFIX), None)
-    if node is None:
-        node = nodes.new("ShaderNodeGroup")
-        node.name = GROUP_PREFIX
-    node.node_tree = group
-    output = next((nd for nd in nodes if nd.type == "OUTPUT_MATERIAL"), None) or nodes.new("ShaderNodeOutputMaterial")
-    links.new(node.outputs["Shader"], output.inputs["Surface"])
-    return node
+    outputs = [nd for nd in nodes if nd.type == "OUTPUT_MATERIAL"]
+    for nd in outputs:
+        if nd.target == "ALL":
+            nd.target = "CYCLES"
+    for row, (target, group) in enumerate(groups.items()):
+        node = group_of(material, target) or next((nd for nd in nodes if nd.name == _node_name(target)), None)
+        if node is None:
+            node = nodes.new("ShaderNodeGroup")
+            node.name = node.label = _node_name(target)
+        node.node_tree = group
+        node.location = (0.0, -200.0 * row)
+        output = next((nd for nd in outputs if nd.target == target), None)
+        if output is None:
+            output = nodes.new("ShaderNodeOutputMaterial")
+            output.target = target
+            outputs.append(output)
+        output.location = (300.0, -200.0 * row)
+        output.is_active_output = True
+        links.new(node.outputs["Shader"], output.inputs["Surface"])

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import bpy
 
-from . import api, jobs
+from . import api, jobs, nodes
 
 
 class PAINTLUT_OT_bake(bpy.types.Operator):
@@ -34,7 +34,8 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
         self._paint = paint
-        self._job = jobs.BakeJob(paint, api.lut_directory(), force=self.force).start()
+        directory = api.lut_directory()
+        self._job = jobs.BakeJob(paint, directory, exact_metallic=nodes.EXACT_METALLIC, force=self.force).start()
         wm = context.window_manager
         self._timer = wm.event_timer_add(0.1, window=context.window)
         wm.progress_begin(0, 100)
@@ -65,7 +66,7 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
             level = {"WARNING"} if self._job.cancelled else {"ERROR"}
             self.report(level, f"Paint LUT: {self._job.error}")
             return {"CANCELLED"}
-        api.store_result(self._material, self._paint, self._job.path, self._job.fit, self._job.weights)
+        api.store_result(self._material, self._paint, self._job.path, self._job.fits)
         self.report({"INFO"}, f"Baked {self._job.path.name}")
         return {"FINISHED"}
 

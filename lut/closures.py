@@ -21,6 +21,11 @@ cos θl included (what Cycles' eval returns), for a white closure:
   Λ.  With α = s this is the paper's Gaussian facet term times G.  A *grey*
   closure: it has no colour input, so its weight is one number for all
   channels (a Mix Shader factor in the node group).
+* ``ggx``:          Principled BSDF with a black base and GGX roughness r: its
+  dielectric specular layer alone, F·D_GGX(α = r²)·G/(4 cos θv) with the
+  height-correlated Smith G of GGX (Walter et al. 2007, Eqs. 33-34).  Grey.
+  EEVEE renders every microfacet lobe as GGX, and Blender 4.2-4.5 have no
+  exact dielectric Metallic, so these are their facet lobes.
 
 Angles follow ``lut.models``: the light at polar angle θl and azimuth π, the
 viewer at (θv, φ), φ = 0 the mirror direction."""
@@ -48,7 +53,7 @@ class Closure:
 
     @property
     def grey(self) -> bool:
-        return self.kind == "metallic"
+        return self.kind in ("metallic", "ggx")
 
     def evaluate(self, theta_l, theta_v, phi):
         if self.kind == "lambert":
@@ -68,7 +73,34 @@ class Closure:
             f = models.facet_reflection(theta_l, theta_v, phi, n=self.ior, slope=alpha, mueller=False)
             g = 1.0 / (1.0 + _beckmann_lambda(theta_l, alpha) + _beckmann_lambda(theta_v, alpha))
             return f * np.cos(theta_l) * g
+        if self.kind == "ggx":
+            return _ggx(theta_l, theta_v, phi, self.ior, self.roughness**2)
         raise ValueError(f"unknown closure kind {self.kind!r}")
+
+
+def _ggx(theta_l, theta_v, phi, n, alpha):
+    """GGX microfacet reflection with exact unpolarized dielectric Fresnel,
+    per unit irradiance, cos θl included: F·D·G/(4 cos θv) (Walter et al.
+    2007, Eqs. 33-34, with the height-correlated Smith G)."""
+    from .models import fresnel
+
+    sl, cl = np.sin(theta_l), np.cos(theta_l)
+    sv, cv = np.sin(theta_v), np.cos(theta_v)
+    # h ∝ l + v with l = (-sin θl, 0, cos θl), v = (sin θv cos φ, sin θv sin φ, cos θv).
+    hx, hy, hz = sv * np.cos(phi) - sl, sv * np.sin(phi), cv + cl
+    norm = np.sqrt(hx * hx + hy * hy + hz * hz)
+    cos_h = hz / norm
+    cos_d = np.clip((-sl * hx + cl * hz) / norm, 0.0, 1.0)
+    a2 = alpha * alpha
+    tan2_h = (1.0 - cos_h * cos_h) / (cos_h * cos_h)
+    d = a2 / (np.pi * cos_h**4 * (a2 + tan2_h) ** 2)
+    f = fresnel._unpolarized_reflectance(cos_d, fresnel.cos_refracted(cos_d, n), n)
+
+    def lam(s, c):
+        return 0.5 * (np.sqrt(1.0 + a2 * (s * s) / (c * c)) - 1.0)
+
+    g = 1.0 / (1.0 + lam(sl, cl) + lam(sv, cv))
+    return f * d * g / (4.0 * cv)
 
 
 def _beckmann_lambda(theta, alpha):
@@ -100,15 +132,36 @@ def smooth_basis():
     return basis
 
 
-def basis_for(paint):
+#: Render engines with a fit of their own.  Cycles evaluates every basis
+#: closure exactly.  EEVEE renders Toon closures as Lambert (and its
+#: microfacet lobes through GGX tables), so its fit uses only the closures it
+#: renders as such: Lambert and the Metallic lobes.
+TARGETS = ("CYCLES", "EEVEE")
+_EEVEE_KINDS = ("lambert", "metallic")
+
+
+def _target(target):
+    if target not in TARGETS:
+        raise ValueError(f"target must be one of {', '.join(TARGETS)}, got {target!r}")
+    return target
+
+
+def basis_for(paint, target="CYCLES", exact_metallic=True):
     """The closures a paint is fitted with: the smooth basis, plus for rough
-    paints Metallic lobes (grey): for Gaussian slopes the paper's facet term
-    exactly (roughness sqrt(slope)); for exponential slopes, which no closure
-    reproduces, lobes of several roughnesses."""
-    basis = smooth_basis()
+    paints grey facet lobes.  With ``exact_metallic`` (Cycles in Blender 5):
+    Metallic Beckmann lobes, for Gaussian slopes the paper's facet term
+    exactly (roughness sqrt(slope)), for exponential slopes (which no closure
+    reproduces) lobes of several roughnesses.  Otherwise (EEVEE, Blender
+    4.2-4.5) GGX lobes of several roughnesses.  For EEVEE only the Lambert
+    and facet closures (it draws Toon closures as Lambert)."""
+    basis = smooth_basis() if _target(target) == "CYCLES" else [Closure("lambert")]
     if paint.slope > 0:
         n = float(paint.index_at(589.3))
-        if paint.distribution == "gaussian" and paint.slope <= 1.0:
+        if target == "EEVEE" or not exact_metallic:
+            roughness = np.sqrt(paint.slope) if paint.distribution == "gaussian" and paint.slope <= 1.0 else 0.7
+            around = np.clip(roughness * np.array([0.7, 0.85, 1.0, 1.2]), 0.05, 1.0)
+            basis += [Closure("ggx", ior=n, roughness=float(r)) for r in np.unique(np.round(around, 3))]
+        elif paint.distribution == "gaussian" and paint.slope <= 1.0:
             basis.append(Closure("metallic", ior=n, roughness=float(np.sqrt(paint.slope))))
         else:
             basis += [Closure("metallic", ior=n, roughness=r) for r in (0.5, 0.7, 0.85, 1.0)]
@@ -163,11 +216,20 @@ class Fit:
 MAX_CLOSURES = 6
 
 
-def fit(paint, views=32, light_polar=24, azimuths=24, basis=None, max_closures=MAX_CLOSURES) -> Fit:
+def fit(
+    paint,
+    views=32,
+    light_polar=24,
+    azimuths=24,
+    basis=None,
+    max_closures=MAX_CLOSURES,
+    target="CYCLES",
+    exact_metallic=True,
+) -> Fit:
     """As ``fit_all``, keeping at most ``max_closures`` closures: those that
     carry the most of the fitted radiance (summed over views, channels and
     light directions), refitted on their own."""
-    full = fit_all(paint, views, light_polar, azimuths, basis)
+    full = fit_all(paint, views, light_polar, azimuths, basis or basis_for(paint, target, exact_metallic))
     max_closures = _validate.positive_int(max_closures, "max_closures")
     if len(full.basis) <= max_closures:
         return full
@@ -241,9 +303,21 @@ def save_weights(fitted: Fit, path) -> pathlib.Path:
     return lutfile.write_exr(path, fitted.weights[::-1], {"paintlut:closures": repr(fitted.basis)})
 
 
-def fit_for_lut(paint, lut_path):
-    """The closure fit of a baked paint and its weights file beside the LUT
-    (``paintfit-<key>.exr`` next to ``paintlut-<key>.exr``)."""
-    fitted = fit(paint)
+def weights_path(lut_path, target="CYCLES") -> pathlib.Path:
+    """The weights file of a target beside its LUT: ``paintfit-<key>.exr``
+    (Cycles) or ``paintfit-eevee-<key>.exr`` next to ``paintlut-<key>.exr``."""
     lut_path = pathlib.Path(lut_path)
-    return fitted, save_weights(fitted, lut_path.with_name(lut_path.name.replace("paintlut-", "paintfit-")))
+    prefix = "paintfit-" if _target(target) == "CYCLES" else f"paintfit-{target.lower()}-"
+    return lut_path.with_name(lut_path.name.replace("paintlut-", prefix))
+
+
+def fit_for_lut(paint, lut_path, exact_metallic=True) -> dict:
+    """The closure fits of a baked paint, one per render engine, with their
+    weights files beside the LUT: {target: (Fit, weights path)}.
+    ``exact_metallic``: whether Blender's Metallic BSDF is the exact
+    dielectric lobe (Blender 5); if not, GGX lobes for Cycles too."""
+    fits = {}
+    for target in TARGETS:
+        fitted = fit(paint, target=target, exact_metallic=exact_metallic)
+        fits[target] = (fitted, save_weights(fitted, weights_path(lut_path, target)))
+    return fits

@@ -20,14 +20,45 @@ from mathutils import Vector
 RESOLUTION = 8
 
 
+#: The fidelity measure's geometries: θl, θv <= 75° and azimuths away from
+#: the exact mirror direction (φ = 0).
+GRID = (np.radians([0, 15, 30, 45, 60, 75]), np.radians([5, 20, 35, 50, 65, 75]), (0.4, 1.1, 1.9, 2.6, 3.1))
+#: A coarser grid for EEVEE, whose renders take seconds, not milliseconds.
+GRID_EEVEE = (np.radians([0, 30, 60, 75]), np.radians([5, 35, 65, 75]), (0.4, 1.9, 3.1))
+
+#: EEVEE's engine id: BLENDER_EEVEE_NEXT in Blender 4.2-4.5.
+EEVEE = "BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else "BLENDER_EEVEE_NEXT"
+
+
+def paints():
+    """The paints the fidelity is measured on: the issue's smooth and rough
+    (satin, matte) cases and the three presets."""
+    import lut
+
+    orange = {"rho": (0.8, 0.4, 0.1), "single": 0.3, "g": 0.3}
+    return {
+        "glossy white": lut.preset("glossy_white"),
+        "smooth single": lut.Paint(**orange),
+        "satin": lut.Paint(**orange, slope=0.25),
+        "matte": lut.Paint(**orange, slope=2.0, distribution="exponential"),
+        "glossy red": lut.preset("glossy_red"),
+        "green CARC": lut.preset("green_carc"),
+    }
+
+
 class Oracle:
-    def __init__(self, irradiance=3.0):
+    """engine "CYCLES" (exact: one sample, no denoising) or EEVEE (not exact:
+    its own approximations of the closures; one sample per pixel)."""
+
+    def __init__(self, irradiance=3.0, engine="CYCLES"):
         bpy.ops.wm.read_factory_settings(use_empty=True)
         scene = bpy.context.scene
-        scene.render.engine = "CYCLES"
+        scene.render.engine = engine
         scene.cycles.device = "CPU"
         scene.cycles.samples = 1
         scene.cycles.use_denoising = False
+        if engine != "CYCLES":
+            scene.eevee.taa_render_samples = 1
         scene.render.resolution_x = scene.render.resolution_y = RESOLUTION
         scene.render.image_settings.file_format = "OPEN_EXR"
         scene.render.image_settings.color_depth = "32"
@@ -84,3 +115,35 @@ class Oracle:
     def brdf(self, theta_l, theta_v, phi):
         """The rendered BRDF: radiance / (E cos θl)."""
         return self.radiance(theta_l, theta_v, phi) / (self.irradiance * math.cos(theta_l))
+
+
+def relative_rms(oracle, paint, grid=GRID, best_scale=False) -> float:
+    """Rendered radiance of the plane's material against ``paint.brdf`` ·
+    cos θl over ``grid``: the cos-weighted relative RMS (the acceptance
+    measure).  ``best_scale``: after the one overall factor that minimizes
+    it (a baseline's most favourable exposure)."""
+    got, ref, weight = [], [], []
+    for tl in grid[0]:
+        for tv in grid[1]:
+            for phi in grid[2]:
+                got.append(oracle.radiance(tl, tv, phi) / oracle.irradiance)
+                ref.append(paint.brdf(tl, tv, phi) * math.cos(tl))
+                weight.append(math.cos(tl))
+    got, ref, weight = np.array(got), np.array(ref), np.array(weight)[:, None]
+    scale = np.sum(got * ref * weight**2) / np.sum((got * weight) ** 2) if best_scale else 1.0
+    return float(np.sqrt(np.sum(((scale * got - ref) * weight) ** 2) / np.sum((ref * weight) ** 2)))
+
+
+def principled(oracle, paint):
+    """The baseline an artist would build without Paint LUT: a Principled BSDF
+    with the paint's diffuse colour ρ (as RGB), IOR n and roughness sqrt(slope) (the
+    Beckmann roughness that gives the paper's Gaussian facet term), on the plane."""
+    mat = oracle.material("principled")
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    bsdf = nodes.new("ShaderNodeBsdfPrincipled")
+    rho = paint.rho.rgb(paint.space) if hasattr(paint.rho, "rgb") else np.asarray(paint.rho, dtype=float)
+    bsdf.inputs["Base Color"].default_value = (*rho, 1.0)
+    bsdf.inputs["IOR"].default_value = float(paint.index_at(589.3))
+    bsdf.inputs["Roughness"].default_value = min(1.0, math.sqrt(paint.slope))
+    links.new(bsdf.outputs[0], nodes["Material Output"].inputs["Surface"])
+    return mat

@@ -96,19 +96,36 @@ def test_background_job_reports_progress_and_can_be_cancelled(tmp_path):
     slow.cancel()
     slow.start()
     assert slow.wait(60) and slow.error == "cancelled" and slow.path is None
-    assert sorted(p.name for p in tmp_path.iterdir()) == [job.path.name]  # nothing half-written
+    # Nothing half-written: only the first job's LUT and its two weights files.
+    expected = [job.path, *(weights for _, weights in job.fits.values())]
+    assert sorted(tmp_path.iterdir()) == sorted(expected)
+    assert set(job.fits) == {"CYCLES", "EEVEE"}
 
 
 def test_bake_wires_a_node_group(material, tmp_path, monkeypatch):
     monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
     material.paint_lut.preset = "glossy_white"
     api.bake_material(material, resolution=(8, 6, 4))
-    output = next(nd for nd in material.node_tree.nodes if nd.type == "OUTPUT_MATERIAL")
-    source = output.inputs["Surface"].links[0].from_node
-    assert source.type == "GROUP" and source.node_tree.name == f"Paint LUT {material.name}"
-    image = next(nd.image for nd in source.node_tree.nodes if nd.type == "TEX_IMAGE")
-    assert image.colorspace_settings.name == "Non-Color"
-    assert sorted(p.name.split("-")[0] for p in tmp_path.iterdir()) == ["paintfit", "paintlut"]
+    tree = material.node_tree
+    for target, suffix in (("CYCLES", ""), ("EEVEE", " Eevee")):
+        # One output per engine, each fed by that engine's group.
+        output = tree.get_output_node(target)
+        assert output.target == target
+        source = output.inputs["Surface"].links[0].from_node
+        assert source.type == "GROUP" and source.node_tree.name == f"Paint LUT {material.name}{suffix}"
+        image = next(nd.image for nd in source.node_tree.nodes if nd.type == "TEX_IMAGE")
+        assert image.colorspace_settings.name == "Non-Color"
+    # EEVEE renders Toon closures as Lambert: its group has none.
+    eevee = addon.nodes.group_of(material, "EEVEE").node_tree
+    assert not any(nd.type == "BSDF_TOON" for nd in eevee.nodes)
+    assert any(nd.type == "BSDF_TOON" for nd in addon.nodes.group_of(material).node_tree.nodes)
+    names = sorted(p.name.rsplit("-", 1)[0] for p in tmp_path.iterdir())
+    assert names == ["paintfit", "paintfit-eevee", "paintlut"]
+    # Rebaking rewires in place: still two outputs and two group nodes.
+    material.paint_lut.stale = True
+    api.bake_material(material, resolution=(8, 6, 4))
+    assert sum(nd.type == "OUTPUT_MATERIAL" for nd in tree.nodes) == 2
+    assert sum(nd.type == "GROUP" for nd in tree.nodes) == 2
     rough = bpy.data.materials.new("rough")
     rough.paint_lut.slope = 0.3
     api.bake_material(rough, resolution=(8, 6, 4))
