@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import pathlib
 import tempfile
 
@@ -58,15 +59,18 @@ def bake_material(material, force=False, **options) -> pathlib.Path:
 
 
 def set_paint(material, paint: lut.Paint) -> None:
-    """Store a paint on a material's settings: a preset by name, an RGB paint
-    by its fields (converted to the scene's working space)."""
+    """Store a paint on a material's settings: a preset by name, another
+    spectral paint whole (the Spectral preset), an RGB paint by its fields
+    (converted to the scene's working space)."""
     settings = material.paint_lut
     for name in lut.PRESETS:
         if paint == lut.preset(name, paint.space):
             settings.preset = name
             return
     if paint.spectral:
-        raise ValueError("spectral paints other than the presets cannot be stored on a material yet; use RGB colours")
+        settings.spectral_paint = json.dumps(paint.to_dict())
+        settings.preset = "SPECTRAL"  # fills the fields with its RGB
+        return
     settings.preset = "CUSTOM"
     properties.set_fields(settings, paint.converted(working_space()))
 

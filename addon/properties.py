@@ -4,16 +4,22 @@ Every ``lut.Paint`` field, with the same limits, plus the preset, the baked
 LUT's path and a stale flag.  Choosing a preset fills the fields with the
 preset's values (its spectral colours shown as RGB in the scene's working
 space) and bakes use the preset's exact spectral paint; editing any physical
-field afterwards makes the paint "Custom"."""
+field afterwards makes the paint "Custom".  Other spectral paints are stored
+whole (``spectral_paint``, JSON) under the "Spectral" preset."""
 
 from __future__ import annotations
+
+import dataclasses
+import json
 
 import bpy
 
 import lut
 
-PRESET_ITEMS = [("CUSTOM", "Custom", "Paint given by the fields below")] + [
-    (name, name.replace("_", " ").title(), f"The paper's {name.replace('_', ' ')} sample") for name in lut.PRESETS
+PRESET_ITEMS = [
+    ("CUSTOM", "Custom", "Paint given by the fields below"),
+    *((name, name.replace("_", " ").title(), f"The paper's {name.replace('_', ' ')} sample") for name in lut.PRESETS),
+    ("SPECTRAL", "Spectral", "A spectral paint stored from Python (addon.api.set_paint); the fields show its RGB"),
 ]
 
 _applying_preset = False
@@ -41,7 +47,10 @@ def _changed(self, context):
 
 def _preset_changed(self, context):
     self.stale = True
-    if self.preset != "CUSTOM":
+    if self.preset == "SPECTRAL":
+        if self.spectral_paint:
+            set_fields(self, self.to_paint())
+    elif self.preset != "CUSTOM":
         set_fields(self, lut.preset(self.preset, working_space()))
 
 
@@ -51,7 +60,7 @@ def set_fields(settings, paint: lut.Paint) -> None:
     global _applying_preset
     _applying_preset = True
     try:
-        settings.n = paint.n
+        settings.n = float(paint.index_at(589.3))  # a dispersive n is shown at the sodium D line
         settings.rho = _rgb(paint.rho, paint.space)
         settings.single = _rgb(paint.single, paint.space)
         settings.g = paint.g
@@ -60,12 +69,6 @@ def set_fields(settings, paint: lut.Paint) -> None:
         settings.facet = paint.facet
     finally:
         _applying_preset = False
-
-
-# Blender 5.0 warns when a "//" path is stored in a FILE_PATH property that
-# does not declare this option.  It is checked on 5.0 only, so earlier
-# versions are not asked for it.
-_RELATIVE_PATH = {"PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (5, 0, 0) else set()
 
 
 def _exact(value):
@@ -123,11 +126,23 @@ class PaintLUTSettings(bpy.types.PropertyGroup):
         name="LUT", subtype="FILE_PATH", description="The baked lookup table", options=_RELATIVE_PATH,
     )  # fmt: skip
     stale: bpy.props.BoolProperty(name="Needs Bake", default=True, description="The paint changed since the last bake")
+    spectral_paint: bpy.props.StringProperty(
+        name="Spectral Paint", options={"HIDDEN"},
+        description="The spectral paint of the Spectral preset, as lut.Paint.to_dict JSON",
+    )  # fmt: skip
 
     def to_paint(self, space: str | None = None) -> lut.Paint:
         """The lut.Paint these settings describe (a preset's exact spectral
         paint while the preset is selected)."""
         space = space or working_space()
+        if self.preset == "SPECTRAL":
+            if not self.spectral_paint:
+                raise ValueError("preset 'Spectral' needs a spectral paint stored with addon.api.set_paint")
+            try:
+                data = json.loads(self.spectral_paint)
+            except ValueError:
+                raise ValueError("the stored spectral paint is not valid JSON; store it again with set_paint") from None
+            return dataclasses.replace(lut.Paint.from_dict(data), space=space)
         if self.preset != "CUSTOM":
             return lut.preset(self.preset, space)
         return lut.Paint(

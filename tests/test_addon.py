@@ -144,8 +144,33 @@ def test_new_material_is_baked_and_wired(tmp_path, monkeypatch):
     assert any(nd.type == "GROUP" for nd in material.node_tree.nodes)
     carc = api.new_material("carc", lut.preset("green_carc"), resolution=(8, 6, 4))
     assert carc.paint_lut.preset == "green_carc"
-    with pytest.raises(ValueError, match="spectral paints other than the presets"):
-        api.new_material("x", lut.Paint(rho="ColorChecker N Ohta/red"))
+
+
+def test_spectral_paints_are_stored_whole(tmp_path, monkeypatch):
+    """A spectral paint that is not a preset survives on the material (and a
+    save) exactly; the fields show its RGB; editing one makes it Custom RGB."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path / "luts")
+    paint = lut.Paint(n=(1.49, 0.0042), rho="ColorChecker N Ohta/blue", single=0.05)
+    material = api.new_material("blue", paint, resolution=(8, 6, 4))
+    material.use_fake_user = True
+    settings = material.paint_lut
+    assert settings.preset == "SPECTRAL" and not settings.stale
+    assert api.paint_of(material) == paint
+    assert settings.n == pytest.approx(float(paint.index_at(589.3)))
+    assert tuple(settings.rho) == pytest.approx(tuple(paint.rho.rgb("Linear Rec.709")), abs=1e-6)
+    blend = tmp_path / "blue.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend))
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    material = bpy.data.materials["blue"]
+    assert api.paint_of(material) == paint
+    material.paint_lut.g = 0.2
+    assert material.paint_lut.preset == "CUSTOM" and material.paint_lut.stale
+    assert not api.paint_of(material).spectral
+    material.paint_lut.spectral_paint = "{broken"
+    material.paint_lut.preset = "SPECTRAL"
+    with pytest.raises(ValueError, match="not valid JSON"):
+        api.paint_of(material)
 
 
 def test_bake_scene_reports_baked_cached_unused(tmp_path, monkeypatch):
