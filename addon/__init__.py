@@ -1,9 +1,9 @@
 """Paint LUT Blender extension: the Blender-facing layer.
 
-Properties, panels and operators live here; all physics and file formats are
-in ``lut``.  Work in progress (issue 4): a bake writes the LUT and, for
-smooth paints, a per-view closure fit wired into the material as a node
-group (Cycles); rough paints and EEVEE's own target are not done yet."""
+Properties, panels, operators, node building and batch baking live here; all
+physics and file formats are in ``lut``.  A bake writes the paint's LUT and
+per-view closure fits (Cycles, EEVEE) and wires them into the material as
+node groups (``nodes``); ``api`` and ``batch`` are the headless entry points."""
 
 import bpy
 
@@ -13,12 +13,15 @@ _MODULES = (properties, operators, panels)
 
 
 def _expose_openimageio():
-    """lut writes EXR files with OpenImageIO: inside Blender use the bundled
-    module unless one is importable already."""
+    """lut writes EXR files with OpenImageIO when it can: inside Blender 4.4+
+    use the bundled module unless one is importable already.  Blender 4.2-4.3
+    have none; lut then uses its own numpy EXR code (lut.exr)."""
     try:
         import OpenImageIO  # noqa: F401
     except ImportError:
-        bpy.utils.expose_bundled_modules()
+        expose = getattr(bpy.utils, "expose_bundled_modules", None)
+        if expose is not None:
+            expose()
 
 
 def register():

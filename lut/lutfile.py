@@ -1,4 +1,5 @@
-"""Paint LUT files: OpenEXR images written and read with OpenImageIO.
+"""Paint LUT files: OpenEXR images written and read with OpenImageIO, or
+without it by lut.exr (numpy; Blender 4.2-4.3 ship no OpenImageIO module).
 
 Layout (format version 1).  A float32 RGB image of width N_u and height
 N_φd · N_θd: pixel (x, y) holds G = f · cos θi · cos θs (``lut.table``) at
@@ -26,6 +27,8 @@ import tempfile
 
 import numpy as np
 
+from . import exr
+
 FORMAT_VERSION = 1
 PARAMETERIZATION = "rusinkiewicz(theta_h=pi/2*u^2, theta_d, phi_d in [0, pi/2]); G = f cos(theta_i) cos(theta_s)"
 
@@ -36,14 +39,64 @@ class LUTError(ValueError):
 
 
 def _oiio():
-    """The OpenImageIO module.  Inside Blender the add-on layer makes Blender's
+    """The OpenImageIO module, or None: then ``lut.exr`` (numpy) reads and
+    writes the files.  Inside Blender 4.4+ the add-on layer makes Blender's
     bundled module importable first (bpy.utils.expose_bundled_modules());
-    ``lut`` itself never imports bpy."""
+    Blender 4.2-4.3 have none.  ``lut`` itself never imports bpy."""
     try:
         import OpenImageIO as oiio
     except ImportError:
-        raise ImportError("Paint LUT files need the OpenImageIO Python module (pip install OpenImageIO)") from None
+        return None
     return oiio
+
+
+def _write_image(path, image, attributes):
+    """Write an RGB float image with attributes (OpenImageIO, ZIP
+    compressed; or uncompressed through lut.exr)."""
+    oiio = _oiio()
+    if oiio is None:
+        exr.write(path, image, ("R", "G", "B"), attributes)
+        return
+    spec = oiio.ImageSpec(image.shape[1], image.shape[0], image.shape[2], oiio.FLOAT)
+    spec.channelnames = ("R", "G", "B")
+    spec.attribute("compression", "zip")
+    spec.attribute("oiio:ColorSpace", "Non-Color")
+    for key, value in attributes.items():
+        spec.attribute(key, value)
+    out = oiio.ImageOutput.create(path)
+    if out is None or not out.open(path, spec):
+        raise OSError(f"cannot write {path}: {oiio.geterror()}")
+    ok = out.write_image(image)
+    out.close()
+    if not ok:
+        raise OSError(f"cannot write {path}: {oiio.geterror()}")
+
+
+def _read_image(path, keys=(), what="file"):
+    """(pixels (height, width, channels) float32, {key: attribute or None})
+    of an EXR file; raises LUTError when it cannot be read."""
+    path = pathlib.Path(path)
+    if not path.is_file():
+        raise LUTError(f"{path}: no such {what}")
+    oiio = _oiio()
+    if oiio is None:
+        try:
+            pixels, _, attrs = exr.read(path)
+        except (exr.EXRError, OSError) as exc:
+            raise LUTError(f"{path}: not a readable EXR image (truncated or corrupt?): {exc}") from None
+        return pixels, {key: attrs.get(key) for key in keys}
+    inp = oiio.ImageInput.open(str(path))
+    if inp is None:
+        raise LUTError(f"{path}: not a readable EXR image (truncated or corrupt?): {oiio.geterror()}")
+    try:
+        spec = inp.spec()
+        attrs = {key: spec.getattribute(key) for key in keys}
+        pixels = inp.read_image(oiio.FLOAT)
+    finally:
+        inp.close()
+    if pixels is None or np.ndim(pixels) != 3:
+        raise LUTError(f"{path}: pixel data cannot be read (truncated file?): {oiio.geterror()}")
+    return np.asarray(pixels, dtype=np.float32), attrs
 
 
 def canonical_json(meta: dict) -> str:
@@ -95,24 +148,10 @@ def write_exr(path, image: np.ndarray, attributes: dict) -> pathlib.Path:
     """Write a float32 (height, width, 3) image with string/int attributes
     atomically: to a temporary file in the same directory, renamed into
     place, so an interrupted write never leaves a partial file under ``path``."""
-    oiio = _oiio()
     path = pathlib.Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     image = np.ascontiguousarray(image, dtype=np.float32)
-    spec = oiio.ImageSpec(image.shape[1], image.shape[0], image.shape[2], oiio.FLOAT)
-    spec.channelnames = ("R", "G", "B")
-    spec.attribute("compression", "zip")
-    spec.attribute("oiio:ColorSpace", "Non-Color")
-    for key, value in attributes.items():
-        spec.attribute(key, value)
     with atomic_target(path) as tmp:
-        out = oiio.ImageOutput.create(tmp)
-        if out is None or not out.open(tmp, spec):
-            raise OSError(f"cannot write {tmp}: {oiio.geterror()}")
-        ok = out.write_image(image)
-        out.close()
-        if not ok:
-            raise OSError(f"cannot write {tmp}: {oiio.geterror()}")
+        _write_image(tmp, image, attributes)
     return path
 
 
@@ -132,73 +171,50 @@ def write(path, table: np.ndarray, meta: dict) -> pathlib.Path:
     )
 
 
-def _open(path):
-    """An open ImageInput of a LUT file and its header; raises LUTError."""
-    oiio = _oiio()
-    path = pathlib.Path(path)
-    if not path.is_file():
-        raise LUTError(f"{path}: no such LUT file")
-    inp = oiio.ImageInput.open(str(path))
-    if inp is None:
-        raise LUTError(f"{path}: not a readable EXR image (truncated or corrupt?): {oiio.geterror()}")
+_KEYS = ("paintlut:format", "paintlut:meta", "paintlut:key", "paintlut:hash")
+
+
+def _load(path):
+    """(pixels, header) of a LUT file; checks the format version."""
+    pixels, attrs = _read_image(path, _KEYS, "LUT file")
+    version = attrs["paintlut:format"]
+    if version is None:
+        raise LUTError(f"{path}: not a Paint LUT (no paintlut:format attribute)")
+    if int(version) != FORMAT_VERSION:
+        raise LUTError(f"{path}: LUT format version {version}; this version of Paint LUT reads {FORMAT_VERSION}")
+    meta_json = attrs["paintlut:meta"]
     try:
-        spec = inp.spec()
-        version = spec.getattribute("paintlut:format")
-        if version is None:
-            raise LUTError(f"{path}: not a Paint LUT (no paintlut:format attribute)")
-        if int(version) != FORMAT_VERSION:
-            raise LUTError(f"{path}: LUT format version {version}; this version of Paint LUT reads {FORMAT_VERSION}")
-        meta_json = spec.getattribute("paintlut:meta")
-        header = {
-            "meta": json.loads(meta_json),
-            "meta_json": meta_json,
-            "key": spec.getattribute("paintlut:key"),
-            "hash": spec.getattribute("paintlut:hash"),
-            "size": (spec.width, spec.height, spec.nchannels),
-        }
-    except BaseException:
-        inp.close()
-        raise
-    return inp, header
+        meta = json.loads(meta_json)
+    except (TypeError, ValueError):
+        raise LUTError(f"{path}: its paintlut:meta is not JSON (altered file)") from None
+    header = {
+        "meta": meta,
+        "meta_json": meta_json,
+        "key": attrs["paintlut:key"],
+        "hash": attrs["paintlut:hash"],
+        "size": (pixels.shape[1], pixels.shape[0], pixels.shape[2]),
+    }
+    return pixels, header
 
 
 def read_exr(path) -> np.ndarray:
     """The float pixels (height, width, channels) of any EXR image, finite
     values required (closure weights files); raises LUTError."""
-    oiio = _oiio()
-    path = pathlib.Path(path)
-    if not path.is_file():
-        raise LUTError(f"{path}: no such file")
-    inp = oiio.ImageInput.open(str(path))
-    if inp is None:
-        raise LUTError(f"{path}: not a readable EXR image (truncated or corrupt?): {oiio.geterror()}")
-    try:
-        pixels = inp.read_image(oiio.FLOAT)
-    finally:
-        inp.close()
-    if pixels is None or np.ndim(pixels) != 3 or not np.all(np.isfinite(pixels)):
-        raise LUTError(f"{path}: pixel data cannot be read or is not finite: {oiio.geterror()}")
-    return np.asarray(pixels)
+    pixels, _ = _read_image(path)
+    if not np.all(np.isfinite(pixels)):
+        raise LUTError(f"{path}: pixel values are not finite")
+    return pixels
 
 
 def read_header(path) -> dict:
     """The header of a LUT file (checks the format version, not the pixels):
     meta, meta_json, key, hash and size (width, height, channels)."""
-    inp, header = _open(path)
-    inp.close()
-    return header
+    return _load(path)[1]
 
 
 def read(path):
     """(table, header) of a LUT file, verified against its content hash."""
-    oiio = _oiio()
-    inp, header = _open(path)
-    try:
-        pixels = inp.read_image(oiio.FLOAT)
-    finally:
-        inp.close()
-    if pixels is None or np.ndim(pixels) != 3:
-        raise LUTError(f"{path}: pixel data cannot be read (truncated file?): {oiio.geterror()}")
+    pixels, header = _load(path)
     meta = header["meta"]
     if header["key"] != cache_key(meta):
         raise LUTError(f"{path}: header key does not match its meta (altered file)")
@@ -207,4 +223,4 @@ def read(path):
     n_u, n_d, n_p = meta["resolution"]
     if pixels.shape != (n_p * n_d, n_u, 3):
         raise LUTError(f"{path}: image size {pixels.shape} does not match resolution {meta['resolution']}")
-    return np.asarray(pixels, dtype=np.float32).reshape(n_p, n_d, n_u, 3), header
+    return pixels.reshape(n_p, n_d, n_u, 3), header

@@ -62,8 +62,11 @@ class Oracle:
         scene.render.resolution_x = scene.render.resolution_y = RESOLUTION
         scene.render.image_settings.file_format = "OPEN_EXR"
         scene.render.image_settings.color_depth = "32"
+        scene.render.image_settings.exr_codec = "ZIP"
         world = bpy.data.worlds.new("black")
         scene.world = world
+        if world.node_tree is None:  # Blender 4.x
+            world.use_nodes = True
         world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
         mesh = bpy.data.meshes.new("plane")
         mesh.from_pydata([(-50, -50, 0), (50, -50, 0), (50, 50, 0), (-50, 50, 0)], [], [(0, 1, 2, 3)])
@@ -87,6 +90,8 @@ class Oracle:
     def material(self, name="oracle"):
         """A new material with an empty node tree and an output node, on the plane."""
         mat = bpy.data.materials.new(name)
+        if mat.node_tree is None:  # Blender 4.x
+            mat.use_nodes = True
         nodes = mat.node_tree.nodes
         for node in list(nodes):
             nodes.remove(node)
@@ -107,9 +112,14 @@ class Oracle:
         self.camera.rotation_euler = view.to_track_quat("Z", "Y").to_euler()
         self.scene.render.filepath = self._path
         bpy.ops.render.render(write_still=True)
-        import OpenImageIO as oiio
+        try:
+            import OpenImageIO as oiio
+        except ImportError:  # Blender 4.2-4.3: lut's own EXR reader
+            from lut import exr
 
-        pixels = oiio.ImageBuf(self._path).get_pixels(oiio.FLOAT)
+            pixels = exr.read(self._path)[0]
+        else:
+            pixels = oiio.ImageBuf(self._path).get_pixels(oiio.FLOAT)
         return np.asarray(pixels[RESOLUTION // 2, RESOLUTION // 2, :3], dtype=float)
 
     def brdf(self, theta_l, theta_v, phi):

@@ -188,3 +188,25 @@ def test_bad_bake_options(tmp_path, kw, message):
 def test_meta_is_plain_json(baked):
     meta = lutfile.read_header(baked["matte"])["meta"]
     assert json.loads(json.dumps(meta)) == meta
+
+
+def test_files_without_openimageio(tmp_path, monkeypatch):
+    """Blender 4.2-4.3 have no OpenImageIO module: lut.exr writes and reads
+    the same files, and each backend reads the other's."""
+    paint = lut.Paint(rho=(0.7, 0.5, 0.2), single=0.2, slope=0.1)
+    with_oiio = lut.bake(paint, tmp_path / "oiio", resolution=(8, 6, 4))
+    monkeypatch.setattr(lutfile, "_oiio", lambda: None)
+    without = lut.bake(paint, tmp_path / "numpy", resolution=(8, 6, 4))
+    assert with_oiio.name == without.name
+    a, b = lut.load_lut(with_oiio), lut.load_lut(without)  # numpy reads OpenImageIO's ZIP file
+    np.testing.assert_array_equal(a.data, b.data)
+    data = without.read_bytes()
+    truncated = tmp_path / "truncated.exr"
+    truncated.write_bytes(data[: len(data) // 2])
+    with pytest.raises(lut.LUTError, match="truncated"):
+        lut.load_lut(truncated)
+    (tmp_path / "junk.exr").write_bytes(b"not an image at all")
+    with pytest.raises(lut.LUTError, match="not a readable EXR"):
+        lut.load_lut(tmp_path / "junk.exr")
+    monkeypatch.undo()
+    np.testing.assert_array_equal(lut.load_lut(without).data, a.data)  # OpenImageIO reads ours
