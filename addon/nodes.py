@@ -158,6 +158,8 @@ def wire(material, groups):
     """Use the groups ({target: node group}) as the material's surface: a
     group node into a Material Output per render engine ('CYCLES', 'EEVEE').
     An existing output for all engines becomes Cycles' output."""
+    if material.node_tree is None:  # Blender 4.x: a new material has no node tree yet
+        material.use_nodes = True
     nodes, links = material.node_tree.nodes, material.node_tree.links
     outputs = [nd for nd in nodes if nd.type == "OUTPUT_MATERIAL"]
     for nd in outputs:

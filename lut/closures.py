@@ -42,14 +42,16 @@ from .models import _validate
 
 @dataclasses.dataclass(frozen=True)
 class Closure:
-    """One basis closure: kind 'lambert', 'diffuse_toon' or 'glossy_toon',
-    with the Toon size and smooth."""
+    """One basis closure: its kind, the Toon size and smooth, the lobes' IOR
+    and roughness, and ``fixed``: a weight the fit must not change (None:
+    fitted)."""
 
     kind: str
     size: float = 0.0
     smooth: float = 0.0
     ior: float = 1.5
     roughness: float = 0.5
+    fixed: float | None = None
 
     @property
     def grey(self) -> bool:
@@ -132,6 +134,10 @@ def smooth_basis():
     return basis
 
 
+#: Gaussian slopes below this make facet lobes too sharp for the fit's light
+#: sampling (24 polar x 24 azimuths): a GGX stand-in keeps the facet weight.
+SHARP_SLOPE = 0.1
+
 #: Render engines with a fit of their own.  Cycles evaluates every basis
 #: closure exactly.  EEVEE renders Toon closures as Lambert (and its
 #: microfacet lobes through GGX tables), so its fit uses only the closures it
@@ -151,20 +157,28 @@ def basis_for(paint, target="CYCLES", exact_metallic=True):
     paints grey facet lobes.  With ``exact_metallic`` (Cycles in Blender 5):
     Metallic Beckmann lobes, for Gaussian slopes the paper's facet term
     exactly (roughness sqrt(slope)), for exponential slopes (which no closure
-    reproduces) lobes of several roughnesses.  Otherwise (EEVEE, Blender
-    4.2-4.5) GGX lobes of several roughnesses.  For EEVEE only the Lambert
-    and facet closures (it draws Toon closures as Lambert)."""
+    reproduces) lobes of several roughnesses.  Otherwise (Blender 4.2-4.5)
+    GGX lobes: one of the facet weight for sharp Gaussian slopes (below
+    ``SHARP_SLOPE``), fitted ones of several roughnesses otherwise.  For EEVEE only the Lambert and facet
+    closures (it draws Toon closures as Lambert; it draws the Metallic
+    lobes as GGX, which measured closer than fitting GGX lobes: README)."""
     basis = smooth_basis() if _target(target) == "CYCLES" else [Closure("lambert")]
     if paint.slope > 0:
         n = float(paint.index_at(589.3))
-        if target == "EEVEE" or not exact_metallic:
-            roughness = np.sqrt(paint.slope) if paint.distribution == "gaussian" and paint.slope <= 1.0 else 0.7
-            around = np.clip(roughness * np.array([0.7, 0.85, 1.0, 1.2]), 0.05, 1.0)
-            basis += [Closure("ggx", ior=n, roughness=float(r)) for r in np.unique(np.round(around, 3))]
-        elif paint.distribution == "gaussian" and paint.slope <= 1.0:
+        gaussian = paint.distribution == "gaussian" and paint.slope <= 1.0
+        if exact_metallic and gaussian:
             basis.append(Closure("metallic", ior=n, roughness=float(np.sqrt(paint.slope))))
-        else:
+        elif exact_metallic:
             basis += [Closure("metallic", ior=n, roughness=r) for r in (0.5, 0.7, 0.85, 1.0)]
+        elif gaussian and paint.slope < SHARP_SLOPE:
+            # GGX of the same alpha has the Beckmann lobe's peak, D(0) =
+            # 1/(pi alpha^2), and heavier tails: keep the facet weight rather
+            # than fit a sharp lobe the fit's sampling cannot resolve.
+            basis.append(Closure("ggx", ior=n, roughness=float(np.sqrt(paint.slope)), fixed=paint.facet))
+        else:
+            centre = float(np.sqrt(paint.slope)) if gaussian else 0.7
+            roughness = np.unique(np.clip(np.round(centre * np.array([0.7, 0.85, 1.0, 1.2]), 3), 0.05, 1.0))
+            basis += [Closure("ggx", ior=n, roughness=float(r)) for r in roughness]
     return basis
 
 
@@ -241,6 +255,7 @@ def fit(
         theta_v = float(np.arccos(np.clip(cv, np.cos(np.radians(89.5)), 1.0)))
         for k, c in enumerate(full.basis):
             energy[k] += np.sum(c.evaluate(theta_l, theta_v, phi) * np.cos(theta_l)) * full.weights[k, j].sum()
+    energy[[k for k, c in enumerate(full.basis) if c.fixed is not None]] = np.inf  # always kept
     keep = sorted(np.argsort(energy)[::-1][:max_closures])
     return fit_all(paint, views, light_polar, azimuths, [full.basis[k] for k in keep])
 
@@ -250,7 +265,8 @@ def fit_all(paint, views=32, light_polar=24, azimuths=24, basis=None) -> Fit:
     non-negative combination of ``basis`` closures (default ``basis_for``):
     one NNLS per view over the three channels together, coloured closures
     with a weight per channel and grey ones with one weight shared by all,
-    rows weighted by cos θl as the fidelity measure is.  A smooth interface's
+    rows weighted by cos θl as the fidelity measure is; closures with a
+    ``fixed`` weight keep it and the others fit what they leave.  A smooth interface's
     mirror reflection is a delta: it is carried by a mirror closure of weight
     ``paint.facet`` with the exact Fresnel reflectance."""
     basis = basis or basis_for(paint)
@@ -259,9 +275,12 @@ def fit_all(paint, views=32, light_polar=24, azimuths=24, basis=None) -> Fit:
     cos_light = np.linspace(np.cos(np.radians(88.0)), 1.0, light_polar)
     theta_l = np.arccos(cos_light)[:, None]
     phi = np.linspace(0.0, np.pi, azimuths)[None, :]
-    colour = [k for k, c in enumerate(basis) if not c.grey]
-    grey = [k for k, c in enumerate(basis) if c.grey]
+    colour = [k for k, c in enumerate(basis) if not c.grey and c.fixed is None]
+    grey = [k for k, c in enumerate(basis) if c.grey and c.fixed is None]
+    pinned = [k for k, c in enumerate(basis) if c.fixed is not None]
     weights = np.zeros((len(basis), views, 3))
+    for k in pinned:
+        weights[k] = basis[k].fixed
     row_w = np.broadcast_to(np.cos(theta_l), (light_polar, azimuths)).ravel()
     num = den = 0.0
     for j, cv in enumerate(cos_view):
@@ -269,6 +288,9 @@ def fit_all(paint, views=32, light_polar=24, azimuths=24, basis=None) -> Fit:
         target = paint.brdf(theta_l, theta_v, phi) * np.cos(theta_l)[..., None]  # (L, P, 3)
         a = np.stack([c.evaluate(theta_l, theta_v, phi).ravel() for c in basis], axis=1) * row_w[:, None]
         b = np.concatenate([target[..., ch].ravel() * row_w for ch in range(3)])
+        full_b = b
+        if pinned:
+            b = b - np.tile(a[:, pinned] @ weights[pinned, j, 0], 3)
         rows = a.shape[0]
         big = np.zeros((3 * rows, 3 * len(colour) + len(grey)))
         for ch in range(3):
@@ -287,7 +309,7 @@ def fit_all(paint, views=32, light_polar=24, azimuths=24, basis=None) -> Fit:
             weights[colour, j, ch] = x[ch * len(colour) : (ch + 1) * len(colour)]
             weights[grey, j, ch] = x[3 * len(colour) :]
         num += np.sum((big @ x - b) ** 2)
-        den += np.sum(b**2)
+        den += np.sum(full_b**2)
     # Closures with zero weight at every view cost render time for nothing.
     used = [k for k in range(len(basis)) if weights[k].max() > 0]
     mirror = paint.facet if paint.slope == 0 else 0.0

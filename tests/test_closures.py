@@ -75,3 +75,20 @@ def test_closure_budget_keeps_the_strongest():
     assert budget.error < 2 * full.error  # the strongest closures carry most of the fit
     with pytest.raises(ValueError, match="max_closures must be a whole number >= 1"):
         closures.fit(paint, max_closures=0)
+
+
+def test_blender_4_lobes_keep_the_facet_weight():
+    """Without an exact Metallic BSDF (Blender 4.2-4.5) a Gaussian facet
+    term becomes one GGX lobe of the same alpha whose weight is the paint's
+    facet weight at every view; the rest is fitted around it."""
+    paint = lut.Paint(rho=0.5, slope=0.05, facet=0.8)
+    basis = closures.basis_for(paint, exact_metallic=False)
+    assert [c for c in basis if c.grey] == [closures.Closure("ggx", ior=1.5, roughness=np.sqrt(0.05), fixed=0.8)]
+    fitted = closures.fit(paint, exact_metallic=False)
+    k = next(k for k, c in enumerate(fitted.basis) if c.kind == "ggx")
+    np.testing.assert_array_equal(fitted.weights[k], 0.8)
+    assert len(fitted.basis) <= closures.MAX_CLOSURES
+    eevee = closures.basis_for(paint, target="EEVEE")
+    assert {c.kind for c in eevee} == {"lambert", "metallic"}
+    with pytest.raises(ValueError, match="target must be one of CYCLES, EEVEE"):
+        closures.basis_for(paint, target="WORKBENCH")

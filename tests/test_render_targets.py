@@ -2,7 +2,6 @@
 oracle: measured, with a loose bound) and, for Blender 4.2-4.5, facet lobes
 made of Principled BSDFs instead of Metallic ones (checked in Cycles)."""
 
-
 import numpy as np
 import pytest
 
