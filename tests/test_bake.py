@@ -100,10 +100,9 @@ def test_progress_is_reported(tmp_path):
     assert seen[-1][0] == seen[-1][1] == 40 * 30 * 20 and len(seen) > 1
 
 
-def test_missing_truncated_altered_and_foreign_files_are_refused(baked, tmp_path):
-    with pytest.raises(lut.LUTError, match="no such LUT file"):
-        lut.load_lut(tmp_path / "nothing.exr")
-    data = baked["smooth"].read_bytes()
+def _refuses_truncated_and_junk(good, tmp_path):
+    """A LUT cut in half and a file that is no image are refused by name."""
+    data = good.read_bytes()
     truncated = tmp_path / "truncated.exr"
     truncated.write_bytes(data[: len(data) // 2])
     with pytest.raises(lut.LUTError, match="truncated"):
@@ -111,6 +110,12 @@ def test_missing_truncated_altered_and_foreign_files_are_refused(baked, tmp_path
     (tmp_path / "junk.exr").write_bytes(b"not an image at all")
     with pytest.raises(lut.LUTError, match="not a readable EXR"):
         lut.load_lut(tmp_path / "junk.exr")
+
+
+def test_missing_truncated_altered_and_foreign_files_are_refused(baked, tmp_path):
+    with pytest.raises(lut.LUTError, match="no such LUT file"):
+        lut.load_lut(tmp_path / "nothing.exr")
+    _refuses_truncated_and_junk(baked["smooth"], tmp_path)
     # Altered pixels under the original header.
     table_, header = lutfile.read(baked["smooth"])
     altered = tmp_path / "altered.exr"
@@ -200,13 +205,6 @@ def test_files_without_openimageio(tmp_path, monkeypatch):
     assert with_oiio.name == without.name
     a, b = lut.load_lut(with_oiio), lut.load_lut(without)  # numpy reads OpenImageIO's ZIP file
     np.testing.assert_array_equal(a.data, b.data)
-    data = without.read_bytes()
-    truncated = tmp_path / "truncated.exr"
-    truncated.write_bytes(data[: len(data) // 2])
-    with pytest.raises(lut.LUTError, match="truncated"):
-        lut.load_lut(truncated)
-    (tmp_path / "junk.exr").write_bytes(b"not an image at all")
-    with pytest.raises(lut.LUTError, match="not a readable EXR"):
-        lut.load_lut(tmp_path / "junk.exr")
+    _refuses_truncated_and_junk(without, tmp_path)
     monkeypatch.undo()
     np.testing.assert_array_equal(lut.load_lut(without).data, a.data)  # OpenImageIO reads ours

@@ -21,3 +21,14 @@ def test_ci_runs_the_readme_commands():
     ci = (ROOT / ".ci" / "run").read_text()
     for command in _readme_commands():
         assert command in ci, f"CI does not run the README command: {command}"
+
+
+def test_readme_pictures_and_scripts_exist():
+    """Everything the README shows is in the repository (made by its scripts)."""
+    readme = (ROOT / "README.md").read_text()
+    pictures = re.findall(r"!\[[^\]]*\]\(([^)]+)\)", readme)
+    assert "docs/figures/presets.png" in pictures
+    scripts = set(re.findall(r"scripts/[a-z_]+\.(?:py|sh)", readme))
+    assert {"scripts/build_extension.py", "scripts/batch_bake.py", "scripts/render_fidelity.py"} <= scripts
+    missing = [p for p in [*pictures, *scripts] if not (ROOT / p).is_file()]
+    assert not missing, missing
