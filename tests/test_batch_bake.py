@@ -163,3 +163,13 @@ def test_an_interrupted_save_keeps_the_old_file(tmp_path, monkeypatch):
         batch.save_atomically(blend)
     assert blend.read_bytes() == before
     assert sorted(os.listdir(tmp_path)) == ["scene.blend"]
+
+
+def test_pack_puts_the_weight_images_in_the_blend(tmp_path):
+    blend = make_blend(tmp_path / "scene.blend", used=("red",), unused=())
+    done = run(blend, "--pack")
+    assert done.returncode == 0, done.stderr
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    images = [img for img in bpy.data.images if img.source == "FILE"]
+    assert len(images) == 2  # the Cycles and EEVEE weights
+    assert all(img.packed_file is not None for img in images)
