@@ -1,6 +1,6 @@
 """Render cost of a Paint LUT material against a Principled BSDF (Cycles).
 
-    .venv/bin/python scripts/render_cost.py [--samples N] [--size PX]
+    .venv/bin/python scripts/render_cost.py [--samples N] [--size PX] [--engine CYCLES|EEVEE]
 
 Renders a UV sphere lit by a Sun and a dim world at 256x256, once with a
 Principled BSDF and once with each preset's baked node group, and prints the
@@ -23,10 +23,11 @@ import lut  # noqa: E402
 from addon import api  # noqa: E402
 
 
-def scene(size, samples):
+def scene(size, samples, engine="CYCLES"):
     bpy.ops.wm.read_factory_settings(use_empty=True)
     sc = bpy.context.scene
-    sc.render.engine = "CYCLES"
+    sc.render.engine = engine
+    sc.eevee.taa_render_samples = samples
     sc.cycles.device = "CPU"
     sc.cycles.samples = samples
     sc.cycles.use_denoising = False
@@ -62,14 +63,20 @@ def timed(sc, repeat=3):
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--samples", type=int, default=16)
+    parser.add_argument("--engine", choices=("CYCLES", "EEVEE"), default="CYCLES")
     parser.add_argument("--size", type=int, default=256)
     args = parser.parse_args(argv)
     addon.register()
-    sc, sphere = scene(args.size, args.samples)
+    engine = (
+        "CYCLES"
+        if args.engine == "CYCLES"
+        else ("BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else "BLENDER_EEVEE_NEXT")
+    )
+    sc, sphere = scene(args.size, args.samples, engine)
     principled = bpy.data.materials.new("principled")
     sphere.data.materials.append(principled)
     base = timed(sc)
-    print(f"Principled BSDF: {base:.3f} s ({args.size}x{args.size}, {args.samples} samples)")
+    print(f"Principled BSDF: {base:.3f} s ({args.engine}, {args.size}x{args.size}, {args.samples} samples)")
     for name in lut.PRESETS:
         material = api.new_material(name, lut.preset(name))
         sphere.data.materials[0] = material
