@@ -92,3 +92,20 @@ def failed(entries) -> bool:
     return any(
         e["status"] == "failed" or any(m["status"] == "failed" for m in e["materials"].values()) for e in entries
     )
+
+
+def summary(entries) -> str:
+    """One line per file (its status and material counts), one per failed material."""
+    lines = []
+    for entry in entries:
+        counts = {}
+        for m in entry["materials"].values():
+            counts[m["status"]] = counts.get(m["status"], 0) + 1
+        text = ", ".join(f"{v} {k}" for k, v in sorted(counts.items())) or "no paint materials"
+        lines.append(
+            f"{entry['file']}: {entry['status']} ({text})" + (f": {entry['reason']}" if "reason" in entry else "")
+        )
+        for name, m in entry["materials"].items():
+            if m["status"] == "failed":
+                lines.append(f"  {name}: failed: {m['reason']}")
+    return "\n".join(lines)

@@ -101,22 +101,6 @@ def bake_parallel(args):
         return [f.result() for f in progress(futures, len(futures))]
 
 
-def summary(entries) -> str:
-    lines = []
-    for entry in entries:
-        counts = {}
-        for m in entry["materials"].values():
-            counts[m["status"]] = counts.get(m["status"], 0) + 1
-        text = ", ".join(f"{v} {k}" for k, v in sorted(counts.items())) or "no paint materials"
-        lines.append(
-            f"{entry['file']}: {entry['status']} ({text})" + (f": {entry['reason']}" if "reason" in entry else "")
-        )
-        for name, m in entry["materials"].items():
-            if m["status"] == "failed":
-                lines.append(f"  {name}: failed: {m['reason']}")
-    return "\n".join(lines)
-
-
 def main(argv=None) -> int:
     args = parse(script_argv() if argv is None else argv)
     entries = bake_parallel(args) if args.jobs > 1 and len(args.files) > 1 else bake_here(args)
@@ -124,9 +108,9 @@ def main(argv=None) -> int:
         from lut import lutfile
 
         lutfile.atomic_write_bytes(args.report, (json.dumps(entries, indent=2) + "\n").encode())
-    print(summary(entries))
     from addon import batch
 
+    print(batch.summary(entries))
     return 1 if batch.failed(entries) else 0
 
 
