@@ -6,10 +6,9 @@ row k, and sums the weighted closures; the smooth interface's mirror
 reflection is a Metallic BSDF (physical conductor, IOR n, no extinction,
 roughness 0: the exact dielectric Fresnel mirror in Blender 5.0) scaled by the
 facet weight, and rough paints' facet lobes are Metallic BSDFs of Beckmann
-roughness (or, for EEVEE and Blender 4.2-4.5, Principled GGX lobes) scaled by
-their (grey) weights.  A material gets one group per
-render engine, each into a Material Output targeted at it (Cycles, EEVEE:
-lut.closures.TARGETS)."""
+roughness (on Blender 4.2-4.5: Principled GGX lobes) scaled by their (grey)
+weights.  A material gets one group per render engine, each into a Material
+Output targeted at it (Cycles, EEVEE: lut.closures.TARGETS)."""
 
 from __future__ import annotations
 

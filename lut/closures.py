@@ -143,7 +143,6 @@ SHARP_SLOPE = 0.1
 #: microfacet lobes through GGX tables), so its fit uses only the closures it
 #: renders as such: Lambert and the Metallic lobes.
 TARGETS = ("CYCLES", "EEVEE")
-_EEVEE_KINDS = ("lambert", "metallic")
 
 
 def _target(target):
@@ -159,9 +158,10 @@ def basis_for(paint, target="CYCLES", exact_metallic=True):
     exactly (roughness sqrt(slope)), for exponential slopes (which no closure
     reproduces) lobes of several roughnesses.  Otherwise (Blender 4.2-4.5)
     GGX lobes: one of the facet weight for sharp Gaussian slopes (below
-    ``SHARP_SLOPE``), fitted ones of several roughnesses otherwise.  For EEVEE only the Lambert and facet
-    closures (it draws Toon closures as Lambert; it draws the Metallic
-    lobes as GGX, which measured closer than fitting GGX lobes: README)."""
+    ``SHARP_SLOPE``), fitted ones of several roughnesses otherwise.  For
+    EEVEE only the Lambert and facet closures (it draws Toon closures as
+    Lambert; it draws the Metallic lobes as GGX, which measured closer than
+    fitting GGX lobes: README)."""
     basis = smooth_basis() if _target(target) == "CYCLES" else [Closure("lambert")]
     if paint.slope > 0:
         n = float(paint.index_at(589.3))
@@ -266,9 +266,9 @@ def fit_all(paint, views=32, light_polar=24, azimuths=24, basis=None) -> Fit:
     one NNLS per view over the three channels together, coloured closures
     with a weight per channel and grey ones with one weight shared by all,
     rows weighted by cos θl as the fidelity measure is; closures with a
-    ``fixed`` weight keep it and the others fit what they leave.  A smooth interface's
-    mirror reflection is a delta: it is carried by a mirror closure of weight
-    ``paint.facet`` with the exact Fresnel reflectance."""
+    ``fixed`` weight keep it and the others fit what they leave.  A smooth
+    interface's mirror reflection is a delta: it is carried by a mirror
+    closure of weight ``paint.facet`` with the exact Fresnel reflectance."""
     basis = basis or basis_for(paint)
     views = _validate.positive_int(views, "views", 2)
     cos_view = np.linspace(0.0, 1.0, views)
