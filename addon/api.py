@@ -1,15 +1,21 @@
-"""Headless API of the add-on (for scripts and farms): no UI involved."""
+"""Headless API of the add-on (for scripts and farms): no UI involved.
+
+A material's paint is a paint *type* (n, g, slope, distribution) baked once
+into a LUT and fitted for every render engine (``lut.render``), and colours
+that are node-group inputs: ``bake_material`` bakes (or reuses) the type and
+wires the groups; ``update_inputs`` sends the colours to the groups, which
+is all a colour edit needs."""
 
 from __future__ import annotations
 
 import json
 import pathlib
-import tempfile
 
 import bpy
 
 import lut
-from lut import closures
+import lut.fitting
+from lut import closures, render
 
 from . import nodes, properties
 from .properties import working_space
@@ -19,11 +25,22 @@ LUT_DIRECTORY = "//paint_lut"
 
 
 def lut_directory() -> pathlib.Path:
-    """Where bakes are written: ``//paint_lut`` next to the saved .blend file,
-    or a temporary folder for an unsaved one."""
+    """Where bakes are written: ``//paint_lut`` next to the saved .blend
+    file, or for an unsaved file the extension's own user folder (Blender's
+    ``extension_path_user``; a per-user folder under the temporary directory
+    when the add-on runs outside an extension)."""
     if bpy.data.filepath:
         return pathlib.Path(bpy.path.abspath(LUT_DIRECTORY))
-    return pathlib.Path(tempfile.gettempdir()) / "paint_lut"
+    package = __package__ or "addon"
+    try:
+        return pathlib.Path(bpy.utils.extension_path_user(package, path="paint_lut", create=True))
+    except (ValueError, AttributeError, RuntimeError):
+        import getpass
+        import tempfile
+
+        folder = pathlib.Path(tempfile.gettempdir()) / f"paint_lut-{getpass.getuser()}"
+        folder.mkdir(parents=True, exist_ok=True)
+        return folder
 
 
 def paint_of(material) -> lut.Paint:
@@ -31,42 +48,109 @@ def paint_of(material) -> lut.Paint:
     return material.paint_lut.to_paint(working_space())
 
 
-def store_result(material, paint, path, fits=None) -> None:
-    """Record a finished bake on the material (path relative to the .blend
-    when it is saved), build and wire its node groups (one per render
-    engine) from ``fits`` ({target: (Fit, weights path)}), and clear the
-    stale flag."""
+class BakeStatus(str):
+    """A material's bake status: the text "baked", "cached", "unused",
+    "linked: <where to bake it>" or "failed: <reason>", with attributes
+    ``state`` (the first word), ``reason``, ``errors`` ({engine: fit error
+    at the material's colours}), ``misses`` ({engine: (error, target)} where
+    the fit misses its target) and ``key`` (the paint type's LUT key:
+    materials with the same key shared one bake)."""
+
+    def __new__(cls, state, reason="", errors=None, misses=None, key=""):
+        self = super().__new__(cls, f"{state}: {reason}" if reason else state)
+        self.state, self.reason = state, reason
+        self.errors, self.misses, self.key = dict(errors or {}), dict(misses or {}), key
+        return self
+
+
+def engine_targets():
+    """The render targets of this Blender: Cycles and EEVEE."""
+    return closures.TARGETS
+
+
+def store_result(material, paint: lut.Paint, result: render.RenderBake, exact_metallic=None, clear_stale=True):
+    """Record a finished bake on the material (LUT path relative to the
+    .blend when it is saved), build or reuse its type's node groups (one per
+    render engine), wire them, set the colour inputs and the fit errors, and
+    (``clear_stale``) clear the stale flag."""
     settings = material.paint_lut
+    path = result.lut_path
     settings.lut_path = bpy.path.relpath(str(path)) if bpy.data.filepath else str(path)
-    if fits:
-        n = float(paint.index_at(589.3))
-        groups = {
-            target: nodes.build_group(nodes.group_name(material, target), fitted, weights, n)
-            for target, (fitted, weights) in fits.items()
-        }
-        nodes.wire(material, groups)
-    settings.stale = False
+    groups = {
+        target: nodes.build_group(fit, result.fit_paths[target], exact_metallic) for target, fit in result.fits.items()
+    }
+    nodes.wire(material, groups, render.node_inputs(paint, result.lut.internal_reflectance))
+    settings.internal_reflectance = result.lut.internal_reflectance
+    settings.fits = json.dumps(
+        {target: {"residual": f.residual.tolist(), "reference": f.reference.tolist(), "goal": f.target_error}
+         for target, f in result.fits.items()}
+    )  # fmt: skip
+    if clear_stale:
+        settings.stale = False
 
 
-def bake_material(material, force=False, **options) -> pathlib.Path:
-    """Bake a material's paint now (blocking): the LUT and the closure fit,
-    wired into the material's node tree as a node group."""
+def bake_material(material, *, directory=None, force=False, exact_metallic=None, progress=None, **options):
+    """Bake a material's paint now (blocking): its type's LUT and closure fits
+    (cached by type: every colour of a type shares them), wired into the
+    material's node tree.  ``directory``: where the files go (default
+    ``lut_directory()``); ``exact_metallic``: whether Blender's Metallic BSDF
+    is the exact dielectric lobe (default: this Blender's,
+    ``nodes.EXACT_METALLIC``).  Returns the ``lut.render.RenderBake``."""
+    exact = nodes.exact_metallic_default(exact_metallic)
     paint = paint_of(material)
-    path = lut.bake(paint, lut_directory(), force=force, **options)
-    store_result(material, paint, path, closures.fit_for_lut(paint, path, exact_metallic=nodes.EXACT_METALLIC))
+    result = render.bake_for_render(
+        paint, directory or lut_directory(), targets=engine_targets(), exact_metallic=exact, force=force,
+        progress=progress, **options,
+    )  # fmt: skip
+    store_result(material, paint, result, exact)
     material.paint_lut.enabled = True
-    return path
+    return result
+
+
+def update_inputs(material) -> None:
+    """Send a material's colours (pigment, single scattering, surface
+    reflection) to its paint groups' inputs: a colour edit needs no bake."""
+    settings = material.paint_lut
+    try:
+        paint = paint_of(material)
+    except ValueError:
+        return
+    rbar = settings.internal_reflectance if settings.internal_reflectance > 0 else None
+    nodes.set_inputs(material, render.node_inputs(paint, rbar))
+
+
+def fit_errors(material) -> dict:
+    """{engine: (error, target)} of the material's current colours against
+    its bake's fits (cos-weighted relative RMS on the acceptance grid); empty
+    before a bake."""
+    settings = material.paint_lut
+    if not settings.fits or settings.internal_reflectance <= 0:
+        return {}
+    try:
+        fits = json.loads(settings.fits)
+        paint = paint_of(material)
+    except ValueError:
+        return {}
+    amps = render.amplitudes_of_inputs(
+        render.node_inputs(paint, settings.internal_reflectance), settings.internal_reflectance
+    )
+    return {
+        target: (lut.fitting.acceptance_error(f["residual"], f["reference"], amps), float(f["goal"]))
+        for target, f in fits.items()
+    }
 
 
 def set_paint(material, paint: lut.Paint) -> None:
     """Store a paint on a material's settings: a preset by name, another
     spectral paint whole (the Spectral preset), an RGB paint by its fields
-    (converted to the scene's working space)."""
+    (converted to the scene's working space).  Values outside the panel's
+    limits are refused (``properties.check_paint``), never clamped."""
     settings = material.paint_lut
     for name in lut.PRESETS:
         if paint == lut.preset(name, paint.space):
             settings.preset = name
             return
+    properties.check_paint(paint)
     if paint.spectral:
         settings.spectral_paint = json.dumps(paint.to_dict())
         settings.preset = "SPECTRAL"  # fills the fields with its RGB
@@ -76,11 +160,16 @@ def set_paint(material, paint: lut.Paint) -> None:
 
 
 def new_material(name: str, paint: lut.Paint, **options):
-    """A new material rendering ``paint``, baked and wired."""
+    """A new material rendering ``paint``, baked and wired (``bake_material``'s
+    options)."""
     material = bpy.data.materials.new(name)
-    set_paint(material, paint)
-    material.paint_lut.enabled = True
-    bake_material(material, **options)
+    try:
+        set_paint(material, paint)
+        material.paint_lut.enabled = True
+        bake_material(material, **options)
+    except Exception:
+        bpy.data.materials.remove(material)
+        raise
     return material
 
 
@@ -89,47 +178,66 @@ def used_materials(scenes) -> set:
     return {slot.material for scene in scenes for obj in scene.objects for slot in obj.material_slots if slot.material}
 
 
-def is_current(material, paint, **options) -> bool:
-    """Whether a material's bake is up to date: not stale, wired, and its LUT
-    and closure weights on disk are readable and verified (a corrupted or
-    missing file means a rebake, not a failure)."""
+def is_current(material, paint, *, directory=None, exact_metallic=None, **options) -> bool:
+    """Whether a material's bake is up to date: not stale, its LUT where this
+    paint type's belongs and verified, each engine's fit readable, verified
+    and of that LUT, and the material wired to this version's groups of
+    those fits (a corrupted or missing file means a rebake, not a failure)."""
     settings = material.paint_lut
     if settings.stale or not settings.lut_path:
         return False
-    path = lut.lut_path(paint, lut_directory(), **options)
+    exact = nodes.exact_metallic_default(exact_metallic)
+    path = lut.lut_path(paint, directory or lut_directory(), **options)
     if pathlib.Path(bpy.path.abspath(settings.lut_path)) != path:
         return False
     try:
-        lut.load_lut(path)
-        for target in closures.TARGETS:
-            lut.lutfile.read_exr(closures.weights_path(path, target))
+        table = lut.load_lut(path)
+        for target in engine_targets():
+            fitted = lut.fitting.read_fit(lut.fitting.fit_path(path, target, exact))
+            if fitted.lut_key != table.key:
+                return False
+            node = nodes.group_of(material, target)
+            if node is None or not nodes.is_paint_group(node.node_tree):
+                return False
+            if node.node_tree.get("paint_lut_fit", "").split(":")[0] != table.key:
+                return False
     except lut.LUTError:
         return False
-    return all(nodes.group_of(material, target) is not None for target in closures.TARGETS)
+    return True
 
 
-def bake_materials(used, force=False, **options) -> dict:
+def bake_materials(used, force=False, *, directory=None, exact_metallic=None, **options) -> dict:
     """Bake the paint materials (those with Use Paint LUT) of the file that
-    are in ``used``.  Returns {material name: status}: "baked" (computed),
-    "cached" (up to date, nothing computed), "unused" (skipped) or
-    "failed: <reason>" (the material is left as it was)."""
+    are in ``used``.  Returns {material name: BakeStatus}: "baked" (computed
+    or wired anew), "cached" (up to date, nothing computed), "unused"
+    (skipped) or "failed: <reason>" (the material is left as it was).
+    Materials of one paint type share one bake: the first computes it, the
+    others find it cached on disk (``BakeStatus.key`` groups them)."""
     status = {}
     for material in bpy.data.materials:
         if not material.paint_lut.enabled:
             continue
         if material not in used:
-            status[material.name] = "unused"
+            status[material.name] = BakeStatus("unused")
             continue
         try:
             paint = paint_of(material)
-            if not force and is_current(material, paint, **options):
-                status[material.name] = "cached"
+            if not force and is_current(material, paint, directory=directory, exact_metallic=exact_metallic, **options):
+                key = lut.lut_path(paint, directory or lut_directory(), **options).stem.split("-")[-1]
+                errors = fit_errors(material)
+                status[material.name] = _status("cached", errors, key)
                 continue
-            bake_material(material, force=force, **options)
-            status[material.name] = "baked"
-        except (ValueError, OSError, RuntimeError) as exc:
-            status[material.name] = f"failed: {exc}"
+            result = bake_material(material, directory=directory, force=force, exact_metallic=exact_metallic, **options)
+            errors = {t: (e, result.fits[t].target_error) for t, e in result.errors(paint).items()}
+            status[material.name] = _status("baked", errors, result.lut_path.stem.split("-")[-1])
+        except (ValueError, OSError, RuntimeError, TypeError, KeyError) as exc:
+            status[material.name] = BakeStatus("failed", str(exc) or type(exc).__name__)
     return status
+
+
+def _status(state, errors, key):
+    misses = {t: v for t, v in errors.items() if v[0] > v[1]}
+    return BakeStatus(state, errors={t: v[0] for t, v in errors.items()}, misses=misses, key=key)
 
 
 def bake_scene(scene, force=False, **options) -> dict:

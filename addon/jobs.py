@@ -1,30 +1,31 @@
-"""Background bakes: lut.bake on a worker thread, with progress and
-cancellation, so the interface never blocks.  Pure Python (no bpy), so it is
-tested without a window."""
+"""Background bakes: ``lut.render.bake_for_render`` (the paint type's LUT and
+every engine's fit) on a worker thread, with progress and cancellation over
+the whole of it, so the interface never blocks.  Pure Python (no bpy), so it
+is tested without a window."""
 
 from __future__ import annotations
 
 import threading
 
 import lut
-from lut import closures
+from lut import closures, render
 
 
 class Cancelled(Exception):
-    """Raised inside the worker to stop a bake; nothing is written."""
+    """Raised inside the worker to stop a bake; nothing is half-written."""
 
 
 class BakeJob:
     """Bake one paint on a thread.  ``progress`` (0..1), ``done``,
-    ``path`` and ``fits`` (on success: lut.closures.fit_for_lut's),
-    ``error`` (a message) and ``cancel()``."""
+    ``result`` (on success: the ``lut.render.RenderBake``), ``error`` (a
+    message) and ``cancel()``."""
 
-    def __init__(self, paint: lut.Paint, directory, exact_metallic=True, **options):
+    def __init__(self, paint: lut.Paint, directory, exact_metallic=True, targets=closures.TARGETS, **options):
         self.paint, self.directory, self.options = paint, directory, options
         self.exact_metallic = exact_metallic
+        self.targets = targets
         self.progress = 0.0
-        self.path = None
-        self.fits = None
+        self.result = None
         self.error = None
         self._cancel = threading.Event()
         self._thread = threading.Thread(target=self._run, name="paint-lut-bake", daemon=True)
@@ -48,18 +49,22 @@ class BakeJob:
         self._thread.join(timeout)
         return self.done
 
-    def _progress(self, done, total):
+    def _progress(self, fraction):
         if self._cancel.is_set():
             raise Cancelled
-        self.progress = done / total if total else 1.0
+        self.progress = fraction
 
     def _run(self):
         try:
-            path = lut.bake(self.paint, self.directory, progress=self._progress, **self.options)
-            self.fits = closures.fit_for_lut(self.paint, path, exact_metallic=self.exact_metallic)
-            self.path = path
+            result = render.bake_for_render(
+                self.paint, self.directory, targets=self.targets, exact_metallic=self.exact_metallic,
+                progress=self._progress, **self.options,
+            )  # fmt: skip
+            if self._cancel.is_set():  # cancelled after the last step: the result is not used
+                raise Cancelled
+            self.result = result
             self.progress = 1.0
         except Cancelled:
             self.error = "cancelled"
         except (ValueError, OSError) as exc:
-            self.error = str(exc)
+            self.error = str(exc) or type(exc).__name__

@@ -21,6 +21,7 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
     _job = None
     _material = None
     _paint = None
+    _type_key = ""
 
     @classmethod
     def poll(cls, context):
@@ -34,8 +35,11 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
         self._paint = paint
-        directory = api.lut_directory()
-        self._job = jobs.BakeJob(paint, directory, exact_metallic=nodes.EXACT_METALLIC, force=self.force).start()
+        self._type_key = self._material.paint_lut.type_key()
+        self._job = jobs.BakeJob(
+            paint, api.lut_directory(), exact_metallic=nodes.EXACT_METALLIC, targets=api.engine_targets(),
+            force=self.force,
+        ).start()  # fmt: skip
         wm = context.window_manager
         self._timer = wm.event_timer_add(0.1, window=context.window)
         wm.progress_begin(0, 100)
@@ -45,12 +49,20 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
     def execute(self, context):
         """Blocking bake, for scripts without an event loop."""
         try:
-            path = api.bake_material(context.material, force=self.force)
-        except ValueError as exc:
+            result = api.bake_material(context.material, force=self.force)
+        except (ValueError, OSError) as exc:
             self.report({"ERROR"}, str(exc))
             return {"CANCELLED"}
-        self.report({"INFO"}, f"Baked {path.name}")
+        self._report_fit(context.material)
+        self.report({"INFO"}, f"Baked {result.lut_path.name}")
         return {"FINISHED"}
+
+    def _report_fit(self, material):
+        for target, (error, goal) in api.fit_errors(material).items():
+            if error > goal:
+                self.report(
+                    {"WARNING"}, f"Paint LUT: {target.title()} fit {100 * error:.1f}% misses its {100 * goal:.0f}%"
+                )
 
     def modal(self, context, event):
         if event.type == "ESC":
@@ -66,8 +78,14 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
             level = {"WARNING"} if self._job.cancelled else {"ERROR"}
             self.report(level, f"Paint LUT: {self._job.error}")
             return {"CANCELLED"}
-        api.store_result(self._material, self._paint, self._job.path, self._job.fits)
-        self.report({"INFO"}, f"Baked {self._job.path.name}")
+        # The paint type edited while the bake ran: wire what was baked but
+        # leave the material stale (its colours are inputs: always current).
+        changed = self._material.paint_lut.type_key() != self._type_key
+        api.store_result(self._material, self._paint, self._job.result, clear_stale=not changed)
+        api.update_inputs(self._material)
+        self._material.paint_lut.enabled = True
+        self._report_fit(self._material)
+        self.report({"INFO"}, f"Baked {self._job.result.lut_path.name}")
         return {"FINISHED"}
 
     def _finish(self, context):

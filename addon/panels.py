@@ -12,19 +12,26 @@ def draw_settings(layout, material):
     col = layout.column(align=False)
     col.use_property_split = True
     col.use_property_decorate = False
+    col.label(text="Colours (live: no bake)")
     col.prop(settings, "rho")
     col.prop(settings, "single")
-    col.prop(settings, "g")
+    col.prop(settings, "facet")
+    col.label(text="Paint type (bake)")
     col.prop(settings, "n")
+    col.prop(settings, "g")
     col.prop(settings, "slope")
     col.prop(settings, "distribution")
-    col.prop(settings, "facet")
     row = layout.row()
     row.operator("paint_lut.bake", icon="RENDER_STILL")
     if settings.stale:
-        layout.label(text="Changed since the last bake", icon="ERROR")
+        layout.label(text="Paint type changed since the last bake", icon="ERROR")
     elif settings.lut_path:
         layout.label(text=bpy.path.basename(settings.lut_path), icon="CHECKMARK")
+        from . import api
+
+        for target, (error, goal) in api.fit_errors(material).items():
+            icon = "CHECKMARK" if error <= goal else "ERROR"
+            layout.label(text=f"{target.title()} fit error {100 * error:.1f}% (target {100 * goal:.0f}%)", icon=icon)
 
 
 class _PaintLUTPanel:

@@ -10,11 +10,13 @@ whole (``spectral_paint``, JSON) under the "Spectral" preset."""
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 
 import bpy
 
 import lut
+import lut.render
 
 PRESET_ITEMS = [
     ("CUSTOM", "Custom", "Paint given by the fields below"),
@@ -38,20 +40,44 @@ def working_space() -> str:
     return name if name in lut.colour_management.WORKING_SPACES else "Linear Rec.709"
 
 
-def _changed(self, context):
-    """A physical field changed: the LUT is stale, and the paint no longer a preset."""
-    self.stale = True
+def _leave_preset(self):
     if not _applying_preset and self.preset != "CUSTOM":
         self["preset"] = 0  # set the enum without re-running its update
 
 
-def _preset_changed(self, context):
+def _type_changed(self, context):
+    """A field that shapes the paint type changed (index, anisotropy, slope,
+    distribution): the bake is stale, and the paint no longer a preset."""
     self.stale = True
+    _leave_preset(self)
+
+
+def _colour_changed(self, context):
+    """A colour changed (pigment, single scattering, surface reflection):
+    the node groups take it as an input at once; no bake, nothing stale."""
+    _leave_preset(self)
+    if not _applying_preset:
+        _send_colours(self)
+
+
+def _send_colours(settings):
+    material = settings.id_data
+    if isinstance(material, bpy.types.Material):
+        from . import api
+
+        api.update_inputs(material)
+
+
+def _preset_changed(self, context):
+    before = self.type_key()
     if self.preset == "SPECTRAL":
         if self.spectral_paint:
             set_fields(self, self.to_paint())
     elif self.preset != "CUSTOM":
         set_fields(self, lut.preset(self.preset, working_space()))
+    if self.type_key() != before or not self.lut_path:
+        self.stale = True
+    _send_colours(self)
 
 
 def set_fields(settings, paint: lut.Paint) -> None:
@@ -60,15 +86,43 @@ def set_fields(settings, paint: lut.Paint) -> None:
     global _applying_preset
     _applying_preset = True
     try:
-        settings.n = float(paint.index_at(589.3))  # a dispersive n is shown at the sodium D line
-        settings.rho = _rgb(paint.rho, paint.space)
-        settings.single = _rgb(paint.single, paint.space)
+        values = node_inputs(paint)
+        settings.n = float(paint.index_at(lut.paint.REFERENCE_WAVELENGTH))  # a dispersive n at the sodium D line
+        settings.rho = values["Pigment Color"]
+        settings.single = values["Single Scattering Color"]
         settings.g = paint.g
         settings.slope = paint.slope
         settings.distribution = paint.distribution.upper()
-        settings.facet = paint.facet
+        settings.facet = values["Surface Reflection"]
     finally:
         _applying_preset = False
+
+
+def check_paint(paint: lut.Paint) -> None:
+    """Refuse a paint that the settings cannot hold as it is (they would
+    clamp it to a different paint): raises ValueError naming the field and
+    its allowed range."""
+    props = PaintLUTSettings.bl_rna.properties
+    values = {"n": float(paint.index_at(lut.paint.REFERENCE_WAVELENGTH)), "g": paint.g, "slope": paint.slope,
+              "facet": paint.facet}  # fmt: skip
+    for name, value in values.items():
+        low, high = props[name].hard_min, props[name].hard_max
+        if not low <= value <= high:
+            raise ValueError(f"{name} must lie in [{low:g}, {high:g}] on a material, got {value!r}")
+
+
+@functools.lru_cache(maxsize=32)
+def _spectral_inputs(paint_json: str):
+    return lut.render.node_inputs(lut.Paint.from_dict(json.loads(paint_json)))
+
+
+def node_inputs(paint: lut.Paint) -> dict:
+    """The group inputs of a paint (``lut.render.node_inputs``): for an RGB
+    paint its own colours; for a spectral one the RGB that renders it
+    exactly (computed once per paint)."""
+    if paint.spectral or paint.dispersive:
+        return dict(_spectral_inputs(json.dumps(paint.to_dict(), sort_keys=True)))
+    return lut.render.node_inputs(paint, internal_reflectance=0.0)
 
 
 def _exact(value):
@@ -76,12 +130,6 @@ def _exact(value):
     0.800000011920929); round to 6 decimals so the paint, and its cache key,
     are those of the number the artist typed."""
     return round(float(value), 6)
-
-
-def _rgb(value, space):
-    if isinstance(value, lut.Spectrum):
-        return tuple(float(v) for v in value.rgb(space).clip(0.0, 1.0))
-    return tuple(value)
 
 
 class PaintLUTSettings(bpy.types.PropertyGroup):
@@ -93,43 +141,58 @@ class PaintLUTSettings(bpy.types.PropertyGroup):
         description="One of the paper's three paints, or Custom",
     )  # fmt: skip
     n: bpy.props.FloatProperty(
-        name="Index", default=1.5, min=1.0, soft_max=2.0, max=4.0, precision=3, update=_changed,
+        name="Index", default=1.5, min=1.0, soft_max=2.0, max=4.0, precision=3, update=_type_changed,
         description="Refractive index of the binder",
     )  # fmt: skip
     rho: bpy.props.FloatVectorProperty(
-        name="Diffuse", subtype="COLOR", size=3, default=(0.8, 0.8, 0.8), min=0.0, max=1.0, update=_changed,
-        description="Reflectance of the multiply scattering substrate (scene-linear RGB)",
+        name="Pigment Color", subtype="COLOR", size=3, default=(0.8, 0.8, 0.8), min=0.0, max=1.0,
+        update=_colour_changed,
+        description="Reflectance rho of the multiply scattering pigment under the binder (scene-linear RGB); "
+        "changes render at once, no bake",
     )  # fmt: skip
     single: bpy.props.FloatVectorProperty(
-        name="Single Scatter", subtype="COLOR", size=3, default=(0.0, 0.0, 0.0), min=0.0, max=1.0, update=_changed,
-        description="Weight of single scattering by pigment particles under the surface",
+        name="Single Scattering Color", subtype="COLOR", size=3, default=(0.0, 0.0, 0.0), min=0.0, max=1.0,
+        update=_colour_changed,
+        description="Albedo of single scattering by pigment particles under the surface; changes render at once",
     )  # fmt: skip
     g: bpy.props.FloatProperty(
-        name="Anisotropy", default=0.0, min=-0.99, max=0.99, update=_changed,
+        name="Anisotropy", default=0.0, min=-0.99, max=0.99, update=_type_changed,
         description="Henyey-Greenstein asymmetry of single scattering (positive: forward)",
     )  # fmt: skip
     slope: bpy.props.FloatProperty(
-        name="Roughness Slope", default=0.0, min=0.0, soft_max=1.0, max=3.0, precision=3, update=_changed,
+        name="Roughness Slope", default=0.0, min=0.0, soft_max=1.0, max=3.0, precision=3, update=_type_changed,
         description="RMS slope of the surface (0: smooth, glossy; 2: very matte)",
     )  # fmt: skip
     distribution: bpy.props.EnumProperty(
         name="Slopes",
         items=[("GAUSSIAN", "Gaussian", "Gaussian slope distribution"),
                ("EXPONENTIAL", "Exponential", "Exponential slope distribution")],
-        default="GAUSSIAN", update=_changed,
+        default="GAUSSIAN", update=_type_changed,
     )  # fmt: skip
     facet: bpy.props.FloatProperty(
-        name="Surface Reflection", default=1.0, min=0.0, max=1.0, update=_changed,
-        description="Weight of the reflection by the surface itself",
+        name="Surface Reflection", default=1.0, min=0.0, max=1.0, update=_colour_changed,
+        description="Weight of the reflection by the surface itself; changes render at once",
     )  # fmt: skip
     lut_path: bpy.props.StringProperty(
         name="LUT", subtype="FILE_PATH", description="The baked lookup table", options=_RELATIVE_PATH,
     )  # fmt: skip
     stale: bpy.props.BoolProperty(name="Needs Bake", default=True, description="The paint changed since the last bake")
+    internal_reflectance: bpy.props.FloatProperty(
+        name="Internal Reflectance", default=0.0, options={"HIDDEN"},
+        description="r-bar of the baked paint type (turns the pigment colour into the diffuse amplitude)",
+    )  # fmt: skip
+    fits: bpy.props.StringProperty(
+        name="Fit Errors", options={"HIDDEN"},
+        description="The baked fits' residual and target matrices per engine (JSON): the error of any colour",
+    )  # fmt: skip
     spectral_paint: bpy.props.StringProperty(
         name="Spectral Paint", options={"HIDDEN"},
         description="The spectral paint of the Spectral preset, as lut.Paint.to_dict JSON",
     )  # fmt: skip
+
+    def type_key(self) -> str:
+        """The fields that shape the paint type, as text (a change means a bake)."""
+        return f"{_exact(self.n)}|{_exact(self.g)}|{_exact(self.slope)}|{self.distribution}|{self.spectral_paint}"
 
     def to_paint(self, space: str | None = None) -> lut.Paint:
         """The lut.Paint these settings describe (a preset's exact spectral

@@ -1,13 +1,24 @@
-"""Baking paints into LUT files, and loading them.
+"""Baking paint types into LUT files, and loading them.
+
+A paint's non-delta BRDF is, per channel, Σ_c a_c · B_c: the angular
+components ``lut.paint.COMPONENTS`` (facet reflection, single scattering,
+diffuse at ρ = 1) scaled by the amplitudes a_c (the facet weight, the
+single-scatter albedo and k(ρ) = ρ(1 - r̄)/(1 - ρ r̄), paper Eq. 27).  Only
+the paint's type (n, g, slope, distribution: ``Paint.type_dict``) shapes the
+components, so a LUT holds the components of a type and every colour of that
+type shares it.
 
 ``bake(paint, directory)`` writes ``paintlut-<key>.exr``, the key being the
-hash of everything that determines the content (paint parameters, working
-space, resolution, quadrature sizes, model and format versions): baking the
-same paint twice costs nothing, and two paints never share a file.  A cached
-file that fails its hash check is baked again."""
+hash of everything that determines the content (the type, resolution,
+quadrature sizes, model and format versions; no colour): baking the same
+type twice costs nothing, and two types never share a file.  A cached file
+that fails its hash check is baked again.
+
+"""
 
 from __future__ import annotations
 
+import json
 import pathlib
 
 import numpy as np
@@ -15,7 +26,7 @@ import numpy as np
 from . import lutfile, table
 from .models import _validate
 from .models.rough import DIFFUSE_NODES
-from .paint import Paint
+from .paint import COMPONENTS, Paint
 
 #: Bumped whenever a model change alters baked values, so old caches miss.
 MODEL_VERSION = 1
@@ -46,29 +57,33 @@ def _resolution(value):
 def describe(
     paint: Paint, resolution=table.DEFAULT_RESOLUTION, single_nodes=BAKE_SINGLE_NODES, diffuse_nodes=DIFFUSE_NODES
 ):
-    """The meta of a bake: everything that determines the LUT's content.
-    Quadrature sizes are recorded only where the paint uses them."""
+    """The meta of a bake: everything that determines the LUT's content, and
+    what a renderer needs besides the table: the paint type, the components
+    and their tiles (1, or 3 for a dispersive paint: one per RGB channel),
+    and the interface's internal reflectance r̄ (which turns a pigment
+    colour into the diffuse amplitude).  Quadrature sizes are recorded only
+    for rough types."""
     if not isinstance(paint, Paint):
         raise ValueError(f"paint must be a lut.Paint, got {type(paint).__name__}")
-    paint_dict = paint.to_dict()
-    paint_dict.pop("name")
+    diffuse_nodes = _validate.nodes(diffuse_nodes, "diffuse_nodes")
     meta = {
         "format": lutfile.FORMAT_VERSION,
         "model_version": MODEL_VERSION,
         "parameterization": lutfile.PARAMETERIZATION,
         "resolution": list(_resolution(resolution)),
-        "space": paint.space,
-        "paint": paint_dict,
+        "type": paint.type_dict(),
+        "components": list(COMPONENTS),
+        "tiles": 3 if paint.dispersive else 1,
+        "internal_reflectance": paint.internal_reflectance(diffuse_nodes),
     }
-    if paint.slope > 0 and paint.has_single:
+    if paint.slope > 0:
         meta["single_nodes"] = list(_validate.nodes(single_nodes, "single_nodes"))
-    if paint.slope > 0 and paint.has_diffuse:
-        meta["diffuse_nodes"] = list(_validate.nodes(diffuse_nodes, "diffuse_nodes"))
+        meta["diffuse_nodes"] = list(diffuse_nodes)
     return meta
 
 
 def lut_path(paint: Paint, directory, **options) -> pathlib.Path:
-    """Where ``bake`` puts (or finds) the LUT of a paint."""
+    """Where ``bake`` puts (or finds) the LUT of a paint's type."""
     return pathlib.Path(directory) / f"paintlut-{lutfile.cache_key(describe(paint, **options))[:24]}.exr"
 
 
@@ -82,10 +97,11 @@ def bake(
     force=False,
     progress=None,
 ) -> pathlib.Path:
-    """Bake a paint's polarization-averaged RGB BRDF into a LUT file in
-    ``directory`` and return its path; a valid cached file is returned as it
-    is unless ``force``.  ``progress(done, total)`` is called as nodes are
-    evaluated.  See docs/lut.md for the format and its accuracy."""
+    """Bake the angular components of a paint's type (``Paint.components``)
+    into a LUT file in ``directory`` and return its path; a valid cached file
+    is returned as it is unless ``force``.  ``progress(done, total)`` is
+    called as nodes are evaluated (it may raise to stop the bake: nothing is
+    written).  See docs/lut.md for the format and its accuracy."""
     meta = describe(paint, resolution, single_nodes, diffuse_nodes)
     path = pathlib.Path(directory) / f"paintlut-{lutfile.cache_key(meta)[:24]}.exr"
     if path.exists() and not force:
@@ -95,38 +111,66 @@ def bake(
         except lutfile.LUTError:
             pass  # damaged or foreign: bake it again
     opts = {"single_nodes": tuple(single_nodes), "diffuse_nodes": tuple(diffuse_nodes)}
+    tiles = meta["tiles"]
 
-    def brdf(ti, ts, ps):
-        return paint.brdf(ti, ts, ps, **opts)
+    def components(ti, ts, ps):
+        return paint.components(ti, ts, ps, **opts).reshape(ti.shape + (tiles * len(COMPONENTS),))
 
-    data = table.tabulate(brdf, tuple(meta["resolution"]), progress=progress)
-    return lutfile.write(path, data, meta)
+    data = table.tabulate(components, tuple(meta["resolution"]), channels=tiles * len(COMPONENTS), progress=progress)
+    n_p, n_d, n_u, _ = data.shape
+    return lutfile.write(path, np.moveaxis(data.reshape(n_p, n_d, n_u, tiles, 3), 3, 0), meta)
 
 
 class LUT:
-    """A loaded LUT: ``evaluate(θi, θs, φs)`` gives the interpolated RGB BRDF
-    [sr⁻¹] (angles as in ``lut.models``), ``meta`` its description and
-    ``paint`` the paint it was baked from."""
+    """A loaded LUT of a paint type: ``components(θi, θs, φs)`` gives the
+    interpolated angular components, ``evaluate(θi, θs, φs, paint)`` the RGB
+    BRDF [sr⁻¹] of a paint of this type (angles as in ``lut.models``),
+    ``meta`` its description.  ``data`` is (tiles, N_φd, N_θd, N_u, 3): G =
+    f·cos θi·cos θs of each component."""
 
-    def __init__(self, data: np.ndarray, meta: dict, path=None):
+    def __init__(self, data: np.ndarray, meta: dict, path=None, key: str = ""):
         self.data = data
         self.meta = meta
         self.path = path
+        self.key = key or lutfile.cache_key(meta)
 
     @property
-    def paint(self) -> Paint:
-        return Paint.from_dict(self.meta["paint"])
+    def internal_reflectance(self) -> float:
+        return float(self.meta["internal_reflectance"])
 
-    def evaluate(self, theta_i, theta_s, phi_s) -> np.ndarray:
+    def matches(self, paint: Paint) -> bool:
+        """Whether ``paint`` is of this LUT's type."""
+        return json.loads(lutfile.canonical_json(paint.type_dict())) == self.meta["type"]
+
+    def components(self, theta_i, theta_s, phi_s) -> np.ndarray:
+        """Components at model angles: broadcast(angles) + (tiles, 3)."""
         ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s)
-        return table.interpolate(self.data, ti, ts, ps)
+        tiles = self.data.shape[0]
+        flat = np.moveaxis(self.data, 0, 3).reshape(self.data.shape[1:4] + (tiles * 3,))
+        return table.interpolate(flat, ti, ts, ps).reshape(ti.shape + (tiles, 3))
+
+    def amplitudes(self, paint: Paint) -> np.ndarray:
+        """(3 channels, 3 components) amplitudes of a paint of this type."""
+        if not self.matches(paint):
+            raise ValueError(f"paint is not of this LUT's type {self.meta['type']}")
+        if paint.dispersive:
+            return paint.amplitudes(self.meta.get("diffuse_nodes", DIFFUSE_NODES))
+        return np.stack(paint._weights(self.internal_reflectance), axis=1)
+
+    def evaluate(self, theta_i, theta_s, phi_s, paint: Paint) -> np.ndarray:
+        """The RGB BRDF of ``paint`` (of this LUT's type): Σ_c a_c·B_c."""
+        comps = self.components(theta_i, theta_s, phi_s)
+        amps = self.amplitudes(paint)
+        if comps.shape[-2] == 1:
+            return comps[..., 0, :] @ amps.T
+        return np.einsum("...hc,hc->...h", comps, amps)
 
     def __repr__(self):
-        return f"LUT({str(self.path)!r}, resolution={self.meta['resolution']}, space={self.meta['space']!r})"
+        return f"LUT({str(self.path)!r}, resolution={self.meta['resolution']}, type={self.meta['type']!r})"
 
 
 def load_lut(path) -> LUT:
     """Load and verify a LUT file.  Raises lut.LUTError (a ValueError) for a
     missing, truncated or altered file, or one of another format version."""
     data, header = lutfile.read(path)
-    return LUT(data, header["meta"], pathlib.Path(path))
+    return LUT(data, header["meta"], pathlib.Path(path), header["key"])

@@ -1,11 +1,15 @@
 """Paint LUT files: OpenEXR images written and read with OpenImageIO, or
 without it by lut.exr (numpy; Blender 4.2-4.3 ship no OpenImageIO module).
 
-Layout (format version 1).  A float32 RGB image of width N_u and height
-N_φd · N_θd: pixel (x, y) holds G = f · cos θi · cos θs (``lut.table``) at
-u = x / (N_u - 1), θd = (y mod N_θd) / (N_θd - 1) · π/2 and
-φd = (y div N_θd) / (N_φd - 1) · π/2, i.e. N_φd tiles of (θh, θd) stacked
-vertically.  The values are data, not colour: read them as Non-Color.
+Layout (format version 2).  A float32 three-channel image of width N_u and
+height T · N_φd · N_θd: T tiles (meta "tiles": 1, or 3 for a dispersive
+paint, one per RGB channel) of N_φd blocks of (θh, θd) stacked vertically.
+Pixel (x, y) of tile t holds, in its channels, G = f · cos θi · cos θs
+(``lut.table``) of the components (meta "components": facet, single,
+diffuse; ``lut.baking``) at u = x / (N_u - 1),
+θd = (y' mod N_θd) / (N_θd - 1) · π/2 and φd = (y' div N_θd) / (N_φd - 1) · π/2,
+y' = y - t · N_φd · N_θd.  The values are data, not colour: read them as
+Non-Color.
 
 Header attributes:
   paintlut:format  the format version (int)
@@ -29,7 +33,7 @@ import numpy as np
 
 from . import exr
 
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
 PARAMETERIZATION = "rusinkiewicz(theta_h=pi/2*u^2, theta_d, phi_d in [0, pi/2]); G = f cos(theta_i) cos(theta_s)"
 
 
@@ -114,8 +118,9 @@ def content_hash(meta_json: str, pixels: np.ndarray) -> str:
 
 
 def _to_image(table: np.ndarray) -> np.ndarray:
-    n_p, n_d, n_u, c = table.shape
-    return np.ascontiguousarray(table.reshape(n_p * n_d, n_u, c), dtype=np.float32)
+    """(tiles, N_φd, N_θd, N_u, 3) or (N_φd, N_θd, N_u, 3) -> (height, N_u, 3)."""
+    n_u, c = table.shape[-2:]
+    return np.ascontiguousarray(table.reshape(-1, n_u, c), dtype=np.float32)
 
 
 @contextlib.contextmanager
@@ -156,7 +161,7 @@ def write_exr(path, image: np.ndarray, attributes: dict) -> pathlib.Path:
 
 
 def write(path, table: np.ndarray, meta: dict) -> pathlib.Path:
-    """Write a LUT table (N_φd, N_θd, N_u, 3) and its meta atomically."""
+    """Write a LUT table (tiles, N_φd, N_θd, N_u, 3) and its meta atomically."""
     image = _to_image(table)
     meta_json = canonical_json(meta)
     return write_exr(
@@ -213,7 +218,8 @@ def read_header(path) -> dict:
 
 
 def read(path):
-    """(table, header) of a LUT file, verified against its content hash."""
+    """(table (tiles, N_φd, N_θd, N_u, 3), header) of a LUT file, verified
+    against its content hash."""
     pixels, header = _load(path)
     meta = header["meta"]
     if header["key"] != cache_key(meta):
@@ -221,6 +227,7 @@ def read(path):
     if header["hash"] != content_hash(header["meta_json"], pixels):
         raise LUTError(f"{path}: content does not match its hash (altered or damaged file)")
     n_u, n_d, n_p = meta["resolution"]
-    if pixels.shape != (n_p * n_d, n_u, 3):
+    tiles = meta.get("tiles", 1)
+    if pixels.shape != (tiles * n_p * n_d, n_u, 3):
         raise LUTError(f"{path}: image size {pixels.shape} does not match resolution {meta['resolution']}")
-    return pixels.reshape(n_p, n_d, n_u, 3), header
+    return pixels.reshape(tiles, n_p, n_d, n_u, 3), header

@@ -22,6 +22,7 @@ coefficients, spectral paints only) evaluates the geometry per band.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 from typing import Any
 
@@ -35,6 +36,38 @@ from .models.rough import DIFFUSE_NODES, SINGLE_NODES
 #: Band edges [nm] for a dispersive index: the geometry is evaluated at each
 #: band's centre wavelength.
 DISPERSION_BANDS = np.linspace(380.0, 780.0, 9)
+
+#: The colour-independent angular components of a paint's non-delta BRDF, in
+#: the order of ``Paint.components`` and ``Paint.amplitudes``: the facet
+#: reflection (unit facet weight), the single-scatter term (unit albedo) and
+#: the diffuse term at ρ = 1.
+COMPONENTS = ("facet", "single", "diffuse")
+
+#: Wavelength [nm] at which a dispersive paint's index is quoted (sodium D).
+REFERENCE_WAVELENGTH = 589.3
+
+
+def diffuse_amplitude(rho, rbar):
+    """k(ρ) = ρ(1 - r̄)/(1 - ρ r̄): the factor of the diffuse term at ρ = 1
+    that gives it at ρ (paper Eq. 27; under a rough interface the same
+    factor with its r̄, the rough counterpart of Eq. 22).  k(0) = 0, k(1) = 1."""
+    rho = np.asarray(rho, dtype=float)
+    return rho * (1.0 - rbar) / (1.0 - rho * rbar)
+
+
+def pigment_of_amplitude(k, rbar):
+    """The inverse of ``diffuse_amplitude``: ρ = k/(1 - r̄ + k r̄)."""
+    k = np.asarray(k, dtype=float)
+    return k / (1.0 - rbar + k * rbar)
+
+
+@functools.lru_cache(maxsize=64)
+def _internal_reflectance(n, slope, distribution, diffuse_nodes):
+    """r̄ (Eq. 22, or its rough counterpart), cached: the rough one takes a
+    quadrature, and panels and caches ask for it often."""
+    if slope > 0.0:
+        return models.rough_internal_reflectance(n, slope, distribution, diffuse_nodes)
+    return models.internal_reflectance(n)
 
 
 def _colour_value(value, name: str):
@@ -149,6 +182,73 @@ class Paint:
         values = self.rho.values if isinstance(self.rho, cm.Spectrum) else self.rho
         return bool(np.any(np.asarray(values) > 0))
 
+    def type_dict(self) -> dict:
+        """What shapes the paint's angular components (``components``): n, g,
+        the slope and its distribution.  Colours, the facet weight and the
+        working space only scale them (``amplitudes``), so every colour of
+        one type shares one LUT.  A dispersive index makes the components
+        differ per RGB channel, with weights that depend on the spectra: such
+        a paint is a type of its own (its whole description)."""
+        if self.dispersive:
+            whole = self.to_dict()
+            whole.pop("name")
+            return whole
+        return {"n": self.n, "g": self.g, "slope": self.slope, "distribution": self.distribution}
+
+    def internal_reflectance(self, diffuse_nodes=DIFFUSE_NODES) -> float:
+        """r̄ of the paint's interface (Eq. 22, or its rough counterpart) at
+        its index (a dispersive one at ``REFERENCE_WAVELENGTH``)."""
+        return _internal_reflectance(
+            float(self.index_at(REFERENCE_WAVELENGTH)), self.slope, self.distribution, tuple(diffuse_nodes)
+        )
+
+    def components(self, theta_i, theta_s, phi_s, *, single_nodes=SINGLE_NODES, diffuse_nodes=DIFFUSE_NODES):
+        """The colour-independent angular components ``COMPONENTS`` (M00,
+        sr⁻¹), shape broadcast(angles) + (T, 3): T = 1 for a non-dispersive
+        paint (the same for every channel), T = 3 (one per RGB channel) for a
+        dispersive one, whose bands are combined per channel with the
+        paint's own weights and divided by ``amplitudes``.  The BRDF is
+        Σ_c amplitudes[ch, c] · components[..., ch or 0, c]; a smooth paint's
+        facet component is 0 (its mirror is a delta)."""
+        ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s, broadcast=False)
+        shape = np.broadcast_shapes(ti.shape, ts.shape, ps.shape)
+        if not self.dispersive:
+            geo = self._geometry(ti, ts, ps, self.n, single_nodes, diffuse_nodes, every_term=True)
+            out = np.zeros(shape + (1, 3))
+            for c, key in enumerate(COMPONENTS):
+                if key in geo:
+                    out[..., 0, c] = geo[key]
+            return out
+        out = np.zeros(shape + (3, 3))
+        total = np.zeros((3, 3))
+        for n, band in self._bands():
+            geo = self._geometry(ti, ts, ps, n, single_nodes, diffuse_nodes, every_term=True)
+            weights = self._weights(geo["rbar"], band)
+            for c, key in enumerate(COMPONENTS):
+                if key in geo:
+                    out[..., :, c] += geo[key][..., None] * weights[c]
+                    total[:, c] += weights[c]
+        return out / np.where(total > 0, total, 1.0)
+
+    def amplitudes(self, diffuse_nodes=DIFFUSE_NODES) -> np.ndarray:
+        """The weights of the components per RGB channel, (3 channels, 3
+        components): the facet weight (times the white of the spectral
+        weights for a spectral paint), the single-scatter albedo and k(ρ)
+        (``diffuse_amplitude``; a spectrum's k integrated per channel, exact
+        because everything else is linear in colour)."""
+        if not self.dispersive:
+            return np.stack(self._weights(self.internal_reflectance(diffuse_nodes)), axis=1)
+        rough = self.slope > 0.0
+        total = np.zeros((3, 3))
+        for n, band in self._bands():
+            rbar = (
+                models.rough_internal_reflectance(n, self.slope, self.distribution, diffuse_nodes)
+                if rough
+                else models.internal_reflectance(n)
+            )
+            total += np.stack(self._weights(rbar, band), axis=1)
+        return total
+
     def to_dict(self) -> dict:
         """A JSON-able description that ``from_dict`` turns back into an
         equal paint; spectra are stored as their sampled values."""
@@ -212,17 +312,17 @@ class Paint:
 
     # ------------------------------------------------------------------ evaluation
 
-    def _geometry(self, ti, ts, ps, n, single_nodes, diffuse_nodes):
+    def _geometry(self, ti, ts, ps, n, single_nodes, diffuse_nodes, every_term=False):
         """M00 of each term with unit weights (the diffuse one at ρ = 1) and
-        the interface's r̄.  Zero-weight terms are not computed; smooth paints
-        never run the rough models."""
+        the interface's r̄.  Zero-weight terms are not computed unless
+        ``every_term``; smooth paints never run the rough models."""
         out = {}
         rough = self.slope > 0.0
-        if self.facet > 0.0 and rough:
+        if (self.facet > 0.0 or every_term) and rough:
             out["facet"] = models.facet_reflection(
                 ti, ts, ps, n=n, slope=self.slope, distribution=self.distribution, mueller=False
             )
-        if self.has_single:
+        if self.has_single or every_term:
             if rough:
                 out["single"] = models.rough_single(
                     ti, ts, ps, n=n, g=self.g, slope=self.slope, distribution=self.distribution,
@@ -230,7 +330,7 @@ class Paint:
                 )  # fmt: skip
             else:
                 out["single"] = models.smooth_single(ti, ts, ps, n=n, g=self.g, mueller=False)
-        if self.has_diffuse:
+        if self.has_diffuse or every_term:
             if rough:
                 out["diffuse"] = models.rough_diffuse(
                     ti, ts, ps, n=n, rho=1.0, slope=self.slope, distribution=self.distribution,
@@ -253,11 +353,8 @@ class Paint:
                 else np.full(w.shape[1], self.single[0])
             )
             rho = self.rho.values[band] if isinstance(self.rho, cm.Spectrum) else np.full(w.shape[1], self.rho[0])
-            k = rho * (1.0 - rbar) / (1.0 - rho * rbar)
-            return self.facet * w.sum(axis=1), w @ single, w @ k
-        rho = np.asarray(self.rho)
-        k = rho * (1.0 - rbar) / (1.0 - rho * rbar)
-        return np.full(3, self.facet), np.asarray(self.single), k
+            return self.facet * w.sum(axis=1), w @ single, w @ diffuse_amplitude(rho, rbar)
+        return np.full(3, self.facet), np.asarray(self.single, dtype=float), diffuse_amplitude(self.rho, rbar)
 
     def _bands(self):
         """(n, wavelength selection) per evaluation of the geometry."""

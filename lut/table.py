@@ -45,19 +45,19 @@ def node_directions(resolution):
     return np.minimum(ti, HORIZON_CLAMP), np.minimum(ts, HORIZON_CLAMP), ps
 
 
-def tabulate(brdf, resolution, chunk=8192, progress=None):
-    """G = brdf · cos θi · cos θs at every node, ``brdf(θi, θs, φs) -> (..., 3)``
+def tabulate(brdf, resolution, chunk=8192, progress=None, channels=3):
+    """G = brdf · cos θi · cos θs at every node, ``brdf(θi, θs, φs) -> (..., channels)``
     evaluated in chunks, calling progress(done, total) after each.  Returns
-    float32 (N_φd, N_θd, N_u, 3)."""
+    float32 (N_φd, N_θd, N_u, channels)."""
     ti, ts, ps = (a.ravel() for a in node_directions(resolution))
-    out = np.empty((ti.size, 3), dtype=np.float32)
+    out = np.empty((ti.size, channels), dtype=np.float32)
     for start in range(0, ti.size, chunk):
         sl = slice(start, start + chunk)
         out[sl] = brdf(ti[sl], ts[sl], ps[sl]) * (np.cos(ti[sl]) * np.cos(ts[sl]))[:, None]
         if progress is not None:
             progress(min(start + chunk, ti.size), ti.size)
     n_u, n_d, n_p = resolution
-    return out.reshape(n_p, n_d, n_u, 3)
+    return out.reshape(n_p, n_d, n_u, channels)
 
 
 def interpolate(table, theta_i, theta_s, phi_s):

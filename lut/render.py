@@ -1,0 +1,144 @@
+"""One operation for everything a renderer needs of a paint: its type's LUT
+and the closure fit of every render target (``bake_for_render``), with
+progress and cancellation over the whole of it; and the values a node group
+takes for a paint's colours (``node_inputs``).
+
+Used by the Blender add-on's operator, its headless API and batch baking
+alike; numpy only."""
+
+from __future__ import annotations
+
+import dataclasses
+import pathlib
+
+import numpy as np
+
+from . import baking, closures, fitting, lutfile
+from .paint import Paint, diffuse_amplitude, pigment_of_amplitude
+
+#: Share of the progress bar taken by the LUT (the fits take the rest).
+LUT_SHARE = 0.7
+
+
+@dataclasses.dataclass
+class RenderBake:
+    """The result of ``bake_for_render``: the LUT, its loaded content, and
+    per target the fit and its weights file; ``computed`` lists what was
+    computed (the rest came from valid cached files)."""
+
+    lut_path: pathlib.Path
+    lut: baking.LUT
+    fits: dict
+    fit_paths: dict
+    computed: list
+
+    @property
+    def key(self) -> str:
+        """The paint type's cache key (shared by every colour of the type)."""
+        return self.lut.key
+
+    def errors(self, paint: Paint) -> dict:
+        """{target: cos-weighted relative RMS of this paint's render on the
+        acceptance grid}."""
+        amps = self.lut.amplitudes(paint)
+        return {target: fit.error(amps) for target, fit in self.fits.items()}
+
+    def misses(self, paint: Paint) -> dict:
+        """{target: (error, target error)} for the targets whose fit misses
+        its goal for this paint's colours."""
+        out = {}
+        for target, error in self.errors(paint).items():
+            goal = self.fits[target].target_error
+            if error > goal:
+                out[target] = (error, goal)
+        return out
+
+
+def _cached_fit(path, lut, target, exact_metallic):
+    """The fit stored at ``path`` if it is valid and belongs to this LUT and
+    target, else None."""
+    if not pathlib.Path(path).exists():
+        return None
+    try:
+        fitted = fitting.read_fit(path)
+    except lutfile.LUTError:
+        return None
+    if fitted.lut_key != lut.key or fitted.target != target or fitted.exact_metallic != exact_metallic:
+        return None
+    return fitted
+
+
+def bake_for_render(
+    paint: Paint,
+    directory,
+    *,
+    targets=closures.TARGETS,
+    exact_metallic=True,
+    force=False,
+    progress=None,
+    **lut_options,
+) -> RenderBake:
+    """Bake the paint's type LUT (``lut.bake``) and fit it for each render
+    target (``lut.fitting.fit_lut``), writing the weights files beside it;
+    valid cached files are reused unless ``force``.  ``progress(fraction)``
+    (0..1) is called throughout and may raise to cancel: files already
+    complete stay (they are valid caches), nothing is half-written."""
+    targets = [closures.validate_target(t) for t in targets]
+    report = progress or (lambda fraction: None)
+    computed = []
+    path = baking.lut_path(paint, directory, **lut_options)
+    existed = path.exists()
+    path = baking.bake(
+        paint, directory, force=force, progress=lambda done, total: report(LUT_SHARE * done / max(total, 1)),
+        **lut_options,
+    )  # fmt: skip
+    table = baking.load_lut(path)
+    if force or not existed:
+        computed.append("lut")
+    report(LUT_SHARE)
+    fits, paths = {}, {}
+    for i, target in enumerate(targets):
+        fit_file = fitting.fit_path(path, target, exact_metallic)
+        fitted = None if force else _cached_fit(fit_file, table, target, exact_metallic)
+        if fitted is None:
+            fitted = fitting.fit_lut(table, target, exact_metallic=exact_metallic)
+            fitting.write_fit(fitted, fit_file)
+            computed.append(target)
+        fits[target], paths[target] = fitted, fit_file
+        report(LUT_SHARE + (1.0 - LUT_SHARE) * (i + 1) / len(targets))
+    return RenderBake(path, table, fits, paths, computed)
+
+
+def node_inputs(paint: Paint, internal_reflectance: float | None = None) -> dict:
+    """The node group inputs that render ``paint``: "Pigment Color" (the RGB
+    ρ whose diffuse amplitude k(ρ) is the paint's; for an RGB paint ρ itself,
+    for a spectral one the ρ that gives the spectrally integrated k exactly),
+    "Single Scattering Color" and "Surface Reflection".  ``internal_reflectance``
+    (r̄ of the type; computed when not given) is what the group computes k with."""
+    rbar = paint.internal_reflectance() if internal_reflectance is None else internal_reflectance
+    if paint.spectral or paint.dispersive:
+        amps = paint.amplitudes()
+        pigment = pigment_of_amplitude(np.clip(amps[:, 2], 0.0, 1.0), rbar)
+        single = amps[:, 1]
+        facet = float(np.mean(amps[:, 0]))
+    else:
+        pigment, single, facet = np.asarray(paint.rho, dtype=float), np.asarray(paint.single), paint.facet
+    return {
+        "Pigment Color": tuple(float(v) for v in np.clip(pigment, 0.0, 1.0)),
+        "Single Scattering Color": tuple(float(v) for v in single),
+        "Surface Reflection": float(facet),
+    }
+
+
+def amplitudes_of_inputs(inputs: dict, internal_reflectance: float) -> np.ndarray:
+    """(3 channels, 3 components) amplitudes a node group computes from its
+    inputs: the facet weight, the single-scatter colour and k(ρ)."""
+    rho = np.asarray(inputs["Pigment Color"], dtype=float)
+    return np.stack(
+        [
+            np.full(3, float(inputs["Surface Reflection"])),
+            np.asarray(inputs["Single Scattering Color"], dtype=float),
+            diffuse_amplitude(rho, internal_reflectance),
+        ],
+        axis=1,
+    )
