@@ -319,6 +319,18 @@ def _setup_toon(node, closure):
     node.inputs["Smooth"].default_value = closure.smooth
 
 
+def _retro(tree, links, lay, closure, rows_k, amps, exact_metallic):
+    """A Diffuse Toon whose normal is the view direction: a retro lobe."""
+    node = lay.place(tree.nodes.new("ShaderNodeBsdfToon"), "closures", "Closures")
+    _setup_toon(node, closure)
+    node.component = "DIFFUSE"
+    node.label = "retro toon"
+    incoming = lay.place(tree.nodes.new("ShaderNodeNewGeometry"), "mix", "Closure colours")
+    links.new(incoming.outputs["Incoming"], node.inputs["Normal"])
+    links.new(_colour(tree, links, lay, rows_k, amps), node.inputs["Color"])
+    return node.outputs[0]
+
+
 def _setup_glossy(node, closure):
     node.distribution = "BECKMANN"
     node.inputs["Roughness"].default_value = closure.roughness
@@ -385,6 +397,7 @@ NODE_BUILDERS = {
     "lambert": _coloured("ShaderNodeBsdfDiffuse", _setup_lambert),
     "diffuse_toon": _coloured("ShaderNodeBsdfToon", _setup_toon),
     "glossy_toon": _coloured("ShaderNodeBsdfToon", _setup_toon),
+    "retro_toon": _retro,
     "glossy": _coloured("ShaderNodeBsdfGlossy", _setup_glossy),
     "sheen": _coloured("ShaderNodeBsdfSheen", _setup_sheen),
     "metallic": _grey(_metallic_node),

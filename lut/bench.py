@@ -185,3 +185,36 @@ def bake_time_vs_error(paints, settings=BAKE_SETTINGS, directory=None, count=200
                 rows.append({"resolution": resolution, "single_nodes": single_nodes, "seconds": seconds, "error": err})
             report[name] = rows
     return report
+
+
+def random_paints(count=24, seed=2026):
+    """A randomised acceptance set spanning the panel's ranges (fixed seed):
+    n 1.3-2.0; ρ per channel log-uniform over 0.01-0.9 (dark and light);
+    single scattering 0-0.3 per channel, in a third of the paints dominant
+    over a dark pigment; g uniform over -0.7..0.8 (both signs); a quarter
+    smooth, the rest slopes log-uniform over 0.05-3 with either distribution;
+    surface reflection 0.5-1.  Returns [(label, lut.Paint)]."""
+    from .paint import Paint
+
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(count):
+        rho = np.exp(rng.uniform(np.log(0.01), np.log(0.9), 3))
+        single = rng.uniform(0.0, 0.3, 3)
+        if i % 3 == 2:  # single scattering dominant over a dark pigment
+            rho = np.exp(rng.uniform(np.log(0.01), np.log(0.06), 3))
+        smooth = i % 4 == 0
+        slope = 0.0 if smooth else float(np.exp(rng.uniform(np.log(0.05), np.log(3.0))))
+        distribution = "gaussian" if rng.random() < 0.5 else "exponential"
+        paint = Paint(
+            n=round(float(rng.uniform(1.3, 2.0)), 3),
+            rho=tuple(round(float(v), 4) for v in rho),
+            single=tuple(round(float(v), 4) for v in single),
+            g=round(float(rng.uniform(-0.7, 0.8)), 3),
+            slope=round(slope, 4),
+            distribution=distribution,
+            facet=round(float(rng.uniform(0.5, 1.0)), 3),
+        )
+        kind = "smooth" if smooth else f"{distribution[:3]} {paint.slope:g}"
+        out.append((f"#{i} {kind} g {paint.g:+.2f}", paint))
+    return out

@@ -16,6 +16,12 @@ irradiance, cos θl included (what Cycles' eval returns), for a white closure:
   (Cycles' bsdf_toon.h; checked against renders in tests).
 * ``glossy_toon``:  Glossy Toon BSDF, the same in the angle between l and the
   mirror of v.
+* ``retro_toon``:   Diffuse Toon BSDF with the view direction as its normal:
+  the same ramp in the angle between l and v (a retro-reflection lobe),
+  times Cycles' bump shadowing term.
+* ``oren_nayar``:   Diffuse BSDF of roughness σ at unit albedo (one closure
+  per channel in the node group).
+* ``sheen``:        Sheen BSDF, Ashikhmin velvet of roughness σ.
 * ``glossy``:       Glossy BSDF, Beckmann, roughness r: D(α = r²)·G/(4 cos θv)
   with no Fresnel factor (Cycles' Glossy BSDF is a white microfacet lobe
   tinted by its colour), G the height-correlated Smith term
@@ -107,6 +113,26 @@ def _glossy_toon(closure, theta_l, theta_v, phi):
     # against the light (-sin θl, 0, cos θl).
     cos_rl = np.sin(theta_v) * np.cos(phi) * np.sin(theta_l) + np.cos(theta_v) * np.cos(theta_l)
     return _toon(np.arccos(np.clip(cos_rl, 0.0, 1.0)), closure.size, closure.smooth)
+
+
+def _retro_toon(closure, theta_l, theta_v, phi):
+    """Diffuse Toon BSDF whose Normal input is the view direction (Geometry ›
+    Incoming): the ramp in the angle between the light and the viewer, a lobe
+    around the retro-reflection direction that no other closure has (for
+    back-scattering pigments, g < 0).  Cycles softens a diffuse closure whose
+    normal differs from the surface's by the microfacet shadowing of Conty
+    Estevez et al. ("A Microfacet-Based Shadowing Function to Solve the Bump
+    Terminator Problem", Ray Tracing Gems, 2019, ch. 12): GGX's G1 at cos θl
+    with α² = tan²θv/8 (Cycles' bump_shadowing_term, with the material's
+    bump map correction on, its default)."""
+    cos_lv = -np.sin(theta_l) * np.sin(theta_v) * np.cos(phi) + np.cos(theta_l) * np.cos(theta_v)
+    ramp = _toon(np.arccos(np.clip(cos_lv, 0.0, 1.0)), closure.size, closure.smooth)
+    cos_v = np.clip(np.cos(theta_v), 1e-6, 1.0)
+    cos_l = np.clip(np.cos(theta_l), 1e-6, 1.0)
+    alpha2 = np.clip(0.125 * (1.0 / cos_v**2 - 1.0), 0.0, 1.0)
+    shadow = 2.0 / (1.0 + np.sqrt(1.0 + alpha2 * (1.0 / cos_l**2 - 1.0)))
+    up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2) & (cos_lv > 0)
+    return np.where(up, ramp * shadow, 0.0)
 
 
 def _half_vector(theta_l, theta_v, phi):
@@ -237,6 +263,7 @@ CLOSURE_KINDS = {
     "lambert": ClosureKind(_lambert),
     "diffuse_toon": ClosureKind(_diffuse_toon),
     "glossy_toon": ClosureKind(_glossy_toon),
+    "retro_toon": ClosureKind(_retro_toon),
     "glossy": ClosureKind(_glossy),
     "sheen": ClosureKind(_sheen),
     "oren_nayar": ClosureKind(_oren_nayar, cost=3),
@@ -297,6 +324,7 @@ def candidates(type_dict: dict, target: str = "CYCLES", exact_metallic: bool = T
         # Oren-Nayar's retro-reflection does; grazing-rising facet terms of
         # very rough surfaces: the velvet sheen.
         basis += [Closure("oren_nayar", roughness=r) for r in (0.5, 1.0)]
+        basis += [Closure("retro_toon", a, s) for a in (0.15, 0.3, 0.5) for s in (0.2, 0.6)]
     slope = float(type_dict["slope"])
     n = type_dict["n"]
     n = float(n if not isinstance(n, list) else sum(c / 0.5893 ** (2 * k) for k, c in enumerate(n)))

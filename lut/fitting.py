@@ -47,11 +47,11 @@ import numpy as np
 
 from . import closures, lutfile
 from .closures import Closure
-from .nnls import nnls_gram
+from .nnls import nnls_gram_batch
 from .paint import COMPONENTS
 
 #: Fit format version: bumped when the weights file layout or the fit changes.
-FIT_VERSION = 1
+FIT_VERSION = 2
 
 #: The acceptance measure's geometries: θl, θv <= 75° and azimuths away from
 #: the exact mirror direction (φ = 0); the Cycles oracle tests use the same.
@@ -254,9 +254,10 @@ def _nnls_fit(gram, rhs, norm, idx, upper):
     # Unconstrained solutions first (all views at once); NNLS only where a
     # weight leaves its bounds.
     x = np.linalg.solve(sub + 1e-13 * scale[:, None, None] * np.eye(len(idx)), g[..., None])[..., 0]
-    bad = np.any(x < 0, axis=1) | np.any(x > upper, axis=1)
-    for m in np.flatnonzero(bad):
-        x[m] = nnls_gram(sub[m], g[m], upper=upper) if norm[m, 0] > 0 else 0.0
+    bad = (np.any(x < 0, axis=1) | np.any(x > upper, axis=1)) & (norm[:, 0] > 0)
+    if bad.any():
+        x[bad] = nnls_gram_batch(sub[bad], g[bad], upper=upper)
+    x[norm[:, 0] == 0] = 0.0
     err = norm[:, 0] - 2 * np.sum(x * g, axis=1) + np.einsum("ms,mst,mt->m", x, sub, x)
     return x, float(_relative(np.maximum(err, 0.0), norm))
 

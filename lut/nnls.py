@@ -63,3 +63,66 @@ def nnls_gram(gram, rhs, tol=None, max_iter=None, upper=None):
                 sub_rhs = rhs[free] - gram[np.ix_(free, np.flatnonzero(over))] @ upper[over]
                 x[free] = nnls_gram(gram[np.ix_(free, free)], sub_rhs, tol=tol, upper=upper[free])
     return x
+
+
+def nnls_gram_batch(gram, rhs, upper=None, max_iter=None):
+    """``nnls_gram`` for a batch of independent problems at once: gram
+    (B, n, n), rhs (B, n) -> x (B, n).  The same active-set iteration, every
+    problem stepping together with its own passive set (a masked system:
+    variables outside the set get an identity row and a zero right-hand
+    side), so the cost is a few batched solves rather than B Python loops.
+    ``upper`` (n,): as in ``nnls_gram``, variables above it are fixed at it
+    and the rest solved again, once."""
+    gram, rhs = np.asarray(gram, dtype=float), np.asarray(rhs, dtype=float)
+    b, n = rhs.shape
+    x = _batch_active_set(gram, rhs, np.zeros((b, n), dtype=bool), max_iter)
+    if upper is not None:
+        upper = np.broadcast_to(np.asarray(upper, dtype=float), (n,))
+        over = x > upper
+        if over.any():
+            fixed_x = np.where(over, upper, 0.0)
+            rhs2 = rhs - np.einsum("bij,bj->bi", gram, fixed_x)
+            x2 = _batch_active_set(gram, rhs2, over, max_iter)
+            x = np.where(over, upper, x2)
+    return x
+
+
+def _batch_active_set(gram, rhs, excluded, max_iter=None):
+    b, n = rhs.shape
+    scale = np.maximum(np.abs(gram).reshape(b, -1).max(axis=1), 1e-300)
+    tol = 1e-12 * scale * max(n, 1)
+    eye = np.eye(n)
+    max_iter = max_iter or 3 * n + 3
+
+    def solve(passive):
+        mask = passive[:, :, None] & passive[:, None, :]
+        sub = np.where(mask, gram, 0.0) + np.where(passive, 1e-13 * scale[:, None], 1.0)[:, :, None] * eye
+        z = np.linalg.solve(sub, np.where(passive, rhs, 0.0)[..., None])[..., 0]
+        return np.where(passive, z, 0.0)
+
+    x = np.zeros((b, n))
+    passive = np.zeros((b, n), dtype=bool)
+    active = np.ones(b, dtype=bool)
+    for _ in range(max_iter):
+        w = rhs - np.einsum("bij,bj->bi", gram, x)
+        candidates = np.where(passive | excluded, -np.inf, w)
+        j = np.argmax(candidates, axis=1)
+        active &= candidates[np.arange(b), j] > tol
+        if not active.any():
+            break
+        passive[np.flatnonzero(active), j[active]] = True
+        for _inner in range(3 * n + 3):
+            z = solve(passive)
+            neg = passive & (z <= 0)
+            bad = active & neg.any(axis=1)
+            good = active & ~bad
+            x[good] = z[good]
+            if not bad.any():
+                break
+            ratio = np.where(neg, x / np.maximum(x - z, 1e-300), np.inf)
+            alpha = np.where(bad, ratio.min(axis=1), 0.0)[:, None]
+            x = np.where(bad[:, None], x + alpha * (z - x), x)
+            passive &= ~(bad[:, None] & (x <= tol[:, None] / scale[:, None]))
+            x = np.where(passive, x, 0.0)
+            active &= passive.any(axis=1) | ~bad
+    return x

@@ -19,6 +19,9 @@ by cos θi cos θs; it returns 0 at or below the horizon.
 
 from __future__ import annotations
 
+import concurrent.futures
+import os
+
 import numpy as np
 
 from . import angles
@@ -45,17 +48,43 @@ def node_directions(resolution):
     return np.minimum(ti, HORIZON_CLAMP), np.minimum(ts, HORIZON_CLAMP), ps
 
 
-def tabulate(brdf, resolution, chunk=8192, progress=None, channels=3):
+def default_workers() -> int:
+    """Threads a bake uses: one per core, at most four (numpy releases the
+    interpreter lock inside its array operations, so chunks run in parallel)."""
+    return max(1, min(4, os.cpu_count() or 1))
+
+
+def tabulate(brdf, resolution, chunk=4096, progress=None, channels=3, workers=None):
     """G = brdf · cos θi · cos θs at every node, ``brdf(θi, θs, φs) -> (..., channels)``
-    evaluated in chunks, calling progress(done, total) after each.  Returns
-    float32 (N_φd, N_θd, N_u, channels)."""
+    evaluated in chunks on ``workers`` threads (default ``default_workers``),
+    calling progress(done, total) on the calling thread as chunks finish (it
+    may raise to stop: chunks not started are dropped).  Returns float32
+    (N_φd, N_θd, N_u, channels)."""
     ti, ts, ps = (a.ravel() for a in node_directions(resolution))
     out = np.empty((ti.size, channels), dtype=np.float32)
-    for start in range(0, ti.size, chunk):
+    starts = range(0, ti.size, chunk)
+
+    def run(start):
         sl = slice(start, start + chunk)
         out[sl] = brdf(ti[sl], ts[sl], ps[sl]) * (np.cos(ti[sl]) * np.cos(ts[sl]))[:, None]
-        if progress is not None:
-            progress(min(start + chunk, ti.size), ti.size)
+        return min(start + chunk, ti.size) - start
+
+    workers = default_workers() if workers is None else max(1, int(workers))
+    done = 0
+    if workers == 1:
+        for start in starts:
+            done += run(start)
+            if progress is not None:
+                progress(done, ti.size)
+    else:
+        pool = concurrent.futures.ThreadPoolExecutor(max_workers=workers, thread_name_prefix="paint-lut-table")
+        try:
+            for future in concurrent.futures.as_completed([pool.submit(run, start) for start in starts]):
+                done += future.result()
+                if progress is not None:
+                    progress(done, ti.size)
+        finally:
+            pool.shutdown(wait=True, cancel_futures=True)
     n_u, n_d, n_p = resolution
     return out.reshape(n_p, n_d, n_u, channels)
 

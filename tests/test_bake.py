@@ -1,5 +1,6 @@
-"""lut.bake and lut.load_lut: accuracy, metadata, cache, skipped work, and
-files that are damaged, foreign or interrupted."""
+"""lut.bake and lut.load_lut: paint types baked into colour-free components,
+accuracy, metadata, cache, and files that are damaged, foreign or
+interrupted."""
 
 import json
 
@@ -33,12 +34,45 @@ def test_lut_matches_the_model_within_one_percent(baked, name):
     ti = np.radians(np.linspace(0.0, 80.0, 33))
     tig, tsg, psg = np.meshgrid(ti, ti, np.linspace(-np.pi, np.pi, 40), indexing="ij")
     model = paint.brdf(tig, tsg, psg)
-    got = lut.load_lut(baked[name]).evaluate(tig, tsg, psg)
+    got = lut.load_lut(baked[name]).evaluate(tig, tsg, psg, paint)
     w = np.cos(tig)[..., None]
     err = np.sqrt(np.sum(((got - model) * w) ** 2) / np.sum((model * w) ** 2))
     assert err < 0.01
     assert got.shape == tig.shape + (3,)
-    assert np.all(lut.load_lut(baked[name]).evaluate(1.6, 0.3, 0.0) == 0)  # below the horizon
+    assert np.all(lut.load_lut(baked[name]).evaluate(1.6, 0.3, 0.0, paint) == 0)  # below the horizon
+
+
+def test_components_recombine_into_the_model_exactly():
+    """Paint.brdf = Σ_c amplitudes · components, for RGB, spectral and
+    dispersive paints, smooth and rough."""
+    rng = np.random.default_rng(4)
+    angles = rng.uniform(0, 1.45, 200), rng.uniform(0, 1.45, 200), rng.uniform(-np.pi, np.pi, 200)
+    paints = [
+        lut.Paint(rho=(0.8, 0.3, 0.05), single=(0.1, 0.2, 0.0), g=-0.4),
+        lut.Paint(rho=0.3, single=0.2, slope=0.4, distribution="exponential", facet=0.7),
+        lut.preset("glossy_red"),
+        lut.Paint(n=(1.49, 0.006), rho="ColorChecker N Ohta/red", single=0.1, slope=0.2),
+    ]
+    for paint in paints:
+        comps, amps = paint.components(*angles), paint.amplitudes()
+        got = np.einsum("...hc,hc->...h", np.broadcast_to(comps, comps.shape[:-2] + (3, 3)), amps)
+        np.testing.assert_allclose(got, paint.brdf(*angles), rtol=1e-12, atol=1e-15)
+
+
+def test_every_colour_of_a_type_shares_one_lut(baked, tmp_path):
+    """The cache key has no colours: another colour (or facet weight) of a
+    baked type is a cache hit and evaluates to that paint; another type is
+    another file."""
+    satin = PAINTS["satin"]
+    recoloured = lut.Paint(**{**satin.__dict__, "rho": (0.1, 0.6, 0.9), "single": 0.0, "facet": 0.5})
+    assert lut.lut_path(recoloured, baked["satin"].parent) == baked["satin"]
+    table_ = lut.load_lut(baked["satin"])
+    ti, ts, ps = np.radians([10.0, 40.0, 70.0]), np.radians([30.0, 50.0, 20.0]), np.array([0.5, 2.0, 3.0])
+    np.testing.assert_allclose(table_.evaluate(ti, ts, ps, recoloured), recoloured.brdf(ti, ts, ps), rtol=0.02)
+    other = lut.Paint(**{**satin.__dict__, "g": 0.31})
+    assert lut.lut_path(other, baked["satin"].parent) != baked["satin"]
+    with pytest.raises(ValueError, match="not of this LUT's type"):
+        table_.evaluate(ti, ts, ps, other)
 
 
 def test_header_describes_the_bake(baked):
@@ -46,12 +80,13 @@ def test_header_describes_the_bake(baked):
     meta = header["meta"]
     assert meta["format"] == lutfile.FORMAT_VERSION
     assert meta["resolution"] == list(table.DEFAULT_RESOLUTION)
-    assert meta["space"] == "Linear Rec.709"
-    assert meta["paint"]["slope"] == 0.25 and meta["paint"]["rho"] == [0.8, 0.45, 0.15]
+    assert meta["type"] == {"n": 1.5, "g": 0.3, "slope": 0.25, "distribution": "gaussian"}  # no colour
+    assert meta["components"] == ["facet", "single", "diffuse"] and meta["tiles"] == 1
+    assert meta["internal_reflectance"] == pytest.approx(PAINTS["satin"].internal_reflectance())
     assert meta["single_nodes"] == [3, 4] and meta["diffuse_nodes"] == [16, 16]
     assert header["key"] == lutfile.cache_key(meta) and len(header["hash"]) == 64
     assert "single_nodes" not in lutfile.read_header(baked["smooth"])["meta"]  # smooth: no quadrature
-    assert lut.load_lut(baked["matte"]).paint == PAINTS["matte"]
+    assert lut.load_lut(baked["matte"]).matches(PAINTS["matte"])
 
 
 def test_same_paint_is_a_cache_hit_that_computes_nothing(baked, monkeypatch):
@@ -61,9 +96,7 @@ def test_same_paint_is_a_cache_hit_that_computes_nothing(baked, monkeypatch):
     monkeypatch.setattr(table, "tabulate", fail)
     named = lut.Paint(**{**PAINTS["satin"].__dict__, "name": "my satin"})
     assert lut.bake(named, baked["satin"].parent) == baked["satin"]
-    assert len({p.name for p in baked.values()}) == 3  # different paints, different files
-    other = lut.Paint(**{**PAINTS["satin"].__dict__, "rho": (0.8, 0.45, 0.16)})
-    assert lut.lut_path(other, baked["satin"].parent) != baked["satin"]
+    assert len({p.name for p in baked.values()}) == 3  # different types, different files
 
 
 def _count_calls(monkeypatch):
@@ -79,15 +112,15 @@ def _count_calls(monkeypatch):
     return calls
 
 
-def test_only_the_needed_terms_are_computed(tmp_path, monkeypatch):
+def test_a_type_bakes_every_component_once(tmp_path, monkeypatch):
+    """Every component of the type is baked whatever the colours (so any
+    colour renders from it), each model evaluated once per chunk, M00 only;
+    smooth types never run the rough models."""
     calls = _count_calls(monkeypatch)
     lut.bake(lut.Paint(n=1.5, rho=0.5, single=0.0), tmp_path, resolution=(8, 6, 4))
-    assert {c[0] for c in calls} == {"smooth_diffuse"}  # smooth paint, no single term: one model
+    assert {c[0] for c in calls} == {"smooth_diffuse", "smooth_single"}
     calls.clear()
     lut.bake(lut.Paint(n=1.5, rho=0.0, single=0.3, slope=0.2, facet=0.0), tmp_path, resolution=(8, 6, 4))
-    assert {c[0] for c in calls} == {"rough_single"}  # zero facet and ρ: neither computed
-    calls.clear()
-    lut.bake(lut.Paint(n=1.5, rho=0.5, single=0.3, slope=0.2), tmp_path, resolution=(8, 6, 4))
     assert {c[0] for c in calls} == {"facet_reflection", "rough_single", "rough_diffuse"}
     assert all(mueller is False for _, mueller in calls)  # M00 only
 
@@ -135,7 +168,7 @@ def test_other_format_version_is_refused(baked, tmp_path, monkeypatch):
     monkeypatch.setattr(lutfile, "FORMAT_VERSION", 99)
     future = lutfile.write(tmp_path / "future.exr", table_, header["meta"])
     monkeypatch.undo()
-    with pytest.raises(lut.LUTError, match="format version 99; this version of Paint LUT reads 1"):
+    with pytest.raises(lut.LUTError, match="format version 99; this version of Paint LUT reads 2"):
         lut.load_lut(future)
 
 
