@@ -275,8 +275,15 @@ def write_exr(path, image: np.ndarray, attributes: dict) -> pathlib.Path:
 
 
 def write(path, table: np.ndarray, meta: dict) -> pathlib.Path:
-    """Write a LUT table (N_φd, N_θd, N_u, 3) and its meta atomically."""
+    """Write a LUT table (N_φd, N_θd, N_u, 3) and its meta atomically.  A
+    table with values that are not finite (a paint beyond float32's range,
+    e.g. a facet lobe far narrower than the table) is refused: ValueError."""
     image = _to_image(table)
+    if not np.all(np.isfinite(image)):
+        raise ValueError(
+            "the baked LUT has values that are not finite (beyond float32's range): the paint's parameters are "
+            "outside what a LUT can hold (for example a slope far below 0.001; use 0 for a smooth surface)"
+        )
     meta_json = canonical_json(meta)
     return write_exr(
         path,

@@ -108,3 +108,179 @@ def test_weights_files_carry_a_verified_hash(tmp_path):
     pixels = np.arange(18, dtype=np.float32).reshape(2, 3, 3)
     path = lutfile.write_exr(tmp_path / "w.exr", pixels, {"paintlut:closures": "('lambert',)"})
     assert np.array_equal(lutfile.read_exr(path), pixels)
+
+
+def test_a_table_that_is_not_finite_is_never_written(tmp_path):
+    import warnings
+
+    paint = lut.Paint(rho=0.5, slope=1e-20)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # float32 overflow while tabulating
+        with pytest.raises(ValueError, match="not finite"):
+            lut.bake(paint, tmp_path, resolution=(8, 6, 4))
+    assert not list(tmp_path.iterdir())
+
+
+# ----------------------------------------------------------------------------- command line: errors
+
+
+def _error_line(capsys):
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    return lines[0]
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--resolution", "4096", "4096", "4096"], "product N_u*N_theta_d*N_phi_d of at most 4194304"),
+        (["--resolution", "1024", "1024", "8"], "got 1024 1024 8 (8388608 nodes)"),
+        (["--single-nodes", "1000", "1000"], "--single-nodes must be two whole numbers in [1, 64]"),
+        (["--n", "1e6"], "n must be in [1, 4], got 1e+06"),
+        (["--slope", "1e300"], "slope must be 0 (smooth) or in [0.001, 3], got 1e+300"),
+        (["--slope", "1e-20"], "slope must be 0 (smooth) or in [0.001, 3], got 1e-20"),
+    ],
+)
+def test_out_of_range_options_get_one_line_naming_the_range(argv, message, tmp_path, capsys):
+    assert main(["bake", *argv, "--out", str(tmp_path)]) == 2
+    assert message in _error_line(capsys)
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        ({"rho": {"spectrum": "ColorChecker N Ohta/red", "scale": None}}, "rho: spectrum scale must be a finite"),
+        ({"rho": {"spectrum": "ColorChecker N Ohta/red", "scale": float("nan")}}, "got nan"),
+        ({"space": ["ACEScg"]}, "space must be one of 'Linear Rec.709', 'Linear Rec.2020', 'ACEScg', got ['ACEScg']"),
+        ({"rho": {"wavelengths": [0.38, 0.55, 0.78], "values": [0.1, 0.5, 0.9]}}, "micrometres? give nanometres"),
+        ({"rho": {"wavelengths": [400, 700], "values": [0.5, "x"]}}, "rho: spectrum wavelengths and values must be"),
+        ({"single": {"values": [0.5]}}, "single: a spectrum needs 'wavelengths' and 'values'"),
+        ({"g": "strong"}, "g must be a real number with -1 < g < 1, got 'strong'"),
+        ({"name": 3}, "name must be text, got 3"),
+        ({"rho": None}, "rho must be an RGB triple"),
+    ],
+)
+def test_bad_paint_files_name_the_file_and_the_parameter(content, message, tmp_path, capsys):
+    path = tmp_path / "paint.json"
+    path.write_text(json.dumps(content))
+    assert main(["bake", "--paint", str(path), "--out", str(tmp_path), *SMALL]) == 2
+    line = _error_line(capsys)
+    assert f"paint file {str(path)!r}" in line and message in line
+
+
+def test_a_spectrum_in_micrometres_is_refused_not_flat_grey():
+    with pytest.raises(ValueError, match="must be in nm"):
+        lut.Spectrum([0.38, 0.5, 0.78], [0.1, 0.5, 0.9])
+    with pytest.raises(ValueError, match="scale must be a finite number >= 0, got nan"):
+        lut.Spectrum([400, 700], [0.1, 0.9], scale=float("nan"))
+
+
+def test_files_that_are_not_utf8_are_named(tmp_path, capsys):
+    toml = tmp_path / "paint.toml"
+    toml.write_bytes(b'rho = 0.5\nname = "caf\xe9"\n')
+    assert main(["bake", "--paint", str(toml), "--out", str(tmp_path)]) == 2
+    assert f"paint file {str(toml)!r} is not UTF-8 text" in _error_line(capsys)
+    csv = tmp_path / "spectrum.csv"
+    csv.write_bytes(b"# r\xe9flectance\n400,0.1\n700,0.9\n")
+    toml.write_text(f"rho = {json.dumps(str(csv))}\n")
+    assert main(["bake", "--paint", str(toml), "--out", str(tmp_path)]) == 2
+    assert f"spectrum file {str(csv)!r} is not UTF-8 text" in _error_line(capsys)
+
+
+# ----------------------------------------------------------------------------- command line: no silent surprises
+
+
+def _baked_paint(capsys):
+    path = capsys.readouterr().out.split()[0]
+    return lut.load_lut(path).meta["paint"]
+
+
+def test_options_override_a_preset_and_a_paint_file(tmp_path, capsys):
+    assert main(["bake", "--preset", "green_carc", "--n", "2", "--out", str(tmp_path), *SMALL]) == 0
+    paint = _baked_paint(capsys)
+    assert paint["n"] == 2.0 and paint["slope"] == lut.preset("green_carc").slope
+    toml = tmp_path / "paint.toml"
+    toml.write_text("rho = 0.4\nslope = 0.1\n")
+    assert main(["bake", "--paint", str(toml), "--slope", "0.3", "--out", str(tmp_path), *SMALL]) == 0
+    paint = _baked_paint(capsys)
+    assert paint["slope"] == 0.3 and paint["rho"] == [0.4, 0.4, 0.4]
+    # An override the preset cannot take is refused, not ignored.
+    assert main(["bake", "--preset", "glossy_red", "--rho", "0.1", "0.2", "0.3", "--out", str(tmp_path)]) == 2
+    assert "rho must be a Spectrum or a grey value in a spectral paint" in _error_line(capsys)
+
+
+def test_info_takes_several_files(tmp_path, capsys):
+    assert main(["example", "--out", str(tmp_path), *SMALL]) == 0
+    luts = sorted((tmp_path / "luts").glob("paintlut-*.exr"))
+    capsys.readouterr()
+    assert len(luts) == 3
+    assert main(["info", *map(str, luts)]) == 0
+    out = capsys.readouterr().out
+    assert [line.split(":")[0] for line in out.splitlines() if line.startswith(str(tmp_path))] == list(map(str, luts))
+    assert main(["info", str(luts[0]), str(tmp_path / "missing.exr")]) == 2
+    captured = capsys.readouterr()
+    assert str(luts[0]) in captured.out and "missing.exr: no such LUT file" in captured.err
+
+
+def test_info_into_a_closed_pipe_is_quiet(tmp_path):
+    path = lut.bake(lut.Paint(rho=0.5), tmp_path, resolution=(8, 6, 4))
+    read_end, write_end = os.pipe()
+    os.close(read_end)  # as `head` does after its lines: every write fails with EPIPE
+    try:
+        done = subprocess.run(
+            [sys.executable, "-m", "lut", "info", str(path), str(path)],
+            stdout=write_end,
+            stderr=subprocess.PIPE,
+            text=True,
+            cwd=ROOT,
+        )
+    finally:
+        os.close(write_end)
+    assert done.stderr == "" and done.returncode == 141
+
+
+def test_ctrl_c_ends_with_one_line_and_status_130(tmp_path, capsys, monkeypatch):
+    from lut import baking
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(baking, "bake", interrupted)
+    assert main(["bake", "--rho", "0.5", "--out", str(tmp_path)]) == 130
+    assert _error_line(capsys) == "interrupted"
+
+
+# ----------------------------------------------------------------------------- clean-up
+
+
+def test_clean_removes_only_luts_and_weights_nothing_keeps(tmp_path, capsys):
+    from lut import cleanup
+
+    kept = lut.bake(lut.Paint(rho=0.2), tmp_path, resolution=(8, 6, 4))
+    gone = lut.bake(lut.Paint(rho=0.7), tmp_path, resolution=(8, 6, 4))
+    for path in (kept, gone):
+        for prefix in ("paintfit-", "paintfit-eevee-"):
+            path.with_name(path.name.replace("paintlut-", prefix)).write_bytes(b"weights")
+    other = tmp_path / "notes.exr"
+    other.write_bytes(b"x")
+    stale = tmp_path / f".{gone.stem}.qwertyui.partial.exr"
+    stale.write_bytes(b"")
+    os.utime(stale, (1, 1))
+    before = sorted(tmp_path.iterdir())
+
+    assert main(["clean", str(tmp_path), "--keep", str(kept), "--dry-run"]) == 0
+    assert sorted(tmp_path.iterdir()) == before
+    assert "would remove 4 file(s)" in capsys.readouterr().out
+    assert main(["clean", str(tmp_path), "--keep", str(kept)]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [kept.name, "notes.exr", kept.name.replace("paintlut-", "paintfit-"),
+         kept.name.replace("paintlut-", "paintfit-eevee-")]
+    )  # fmt: skip
+    assert "removed 4 file(s)" in capsys.readouterr().out
+    with pytest.raises(ValueError, match="not a LUT"):
+        cleanup.clean(tmp_path, keep=[other])
+    assert main(["clean", str(tmp_path / "missing"), "--keep"]) == 2
+    assert "no such directory" in _error_line(capsys)
