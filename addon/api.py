@@ -85,8 +85,23 @@ def new_material(name: str, paint: lut.Paint, **options):
 
 
 def used_materials(scenes) -> set:
-    """The materials on the objects of ``scenes``."""
-    return {slot.material for scene in scenes for obj in scene.objects for slot in obj.material_slots if slot.material}
+    """The materials ``scenes`` render: those of every object instance their
+    view layers' depsgraphs evaluate (collection instances, Geometry Nodes'
+    Set Material and instances included), and those in the slots of their
+    objects (hidden ones too).  Original (not evaluated) materials."""
+    used = set()
+    for scene in scenes:
+        for obj in scene.objects:
+            used.update(slot.material for slot in obj.material_slots if slot.material)
+        for view_layer in scene.view_layers:
+            depsgraph = view_layer.depsgraph
+            depsgraph.update()
+            for instance in depsgraph.object_instances:
+                obj = instance.object
+                materials = [slot.material for slot in obj.material_slots]
+                materials += list(getattr(obj.data, "materials", None) or ())
+                used.update(m.original for m in materials if m is not None)
+    return used
 
 
 def is_current(material, paint, **options) -> bool:
