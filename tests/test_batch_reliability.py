@@ -16,6 +16,7 @@ import pytest
 bpy = pytest.importorskip("bpy")
 
 import addon  # noqa: E402
+import lut  # noqa: E402
 from addon import api, batch  # noqa: E402
 from lut import lutfile  # noqa: E402
 
@@ -264,3 +265,49 @@ def test_an_unwritable_report_fails_before_any_work(tmp_path, where):
     assert done.returncode == 2
     assert "--report" in done.stderr and "Traceback" not in done.stderr
     assert blend.read_bytes() == before and not (tmp_path / "paint_lut").exists()
+
+
+# ----------------------------------------------------------------------------- paints a material cannot hold
+
+
+@pytest.mark.parametrize(
+    ("fields", "message"),
+    [
+        ({"n": 0.8}, "n must be in [1, 4] on a material (the Paint LUT panel's limits), got 0.8"),
+        ({"n": 5.0}, "n must be in [1, 4]"),
+        ({"facet": 2.0}, "facet must be in [0, 1]"),
+        ({"g": 0.995}, "g must be in [-0.99, 0.99]"),
+        ({"slope": 3.5}, "slope must be in [0, 3]"),
+    ],
+)
+def test_paints_beyond_the_panel_limits_are_refused(fields, message):
+    from addon import validation
+
+    with pytest.raises(ValueError, match=message.replace("[", r"\[").replace("(", r"\(").replace(")", r"\)")):
+        validation.check_paint_fits(lut.Paint(**fields), "Linear Rec.709")
+
+
+def test_paints_within_the_limits_presets_and_spectral_paints_fit():
+    from addon import validation
+
+    for paint in (
+        lut.Paint(n=1.0, g=-0.99, slope=3.0, facet=1.0, rho=(1.0, 0.0, 0.5)),
+        lut.Paint(n=4.0, g=0.99),
+        lut.preset("green_carc"),
+        lut.Paint(n=0.8, rho="ColorChecker N Ohta/blue"),  # spectral: stored whole, never clamped
+    ):
+        validation.check_paint_fits(paint, "Linear Rec.709")
+    # A saturated Rec.2020 red lies outside Rec.709: the material would clip it.
+    with pytest.raises(ValueError, match="rho must be in \\[0, 1\\] per channel in the scene's working space"):
+        validation.check_paint_fits(lut.Paint(rho=(1.0, 0.0, 0.0), space="Linear Rec.2020"), "Linear Rec.709")
+    validation.check_paint_fits(lut.Paint(rho=(1.0, 0.0, 0.0), space="Linear Rec.709"), "Linear Rec.2020")
+
+
+def test_the_limits_are_those_that_clamp_today(tmp_path, monkeypatch):
+    """What the check refuses is exactly what set_paint would change."""
+    new_file()
+    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
+    for paint in (lut.Paint(n=0.8), lut.Paint(n=5.0), lut.Paint(facet=2.0), lut.Paint(g=0.995)):
+        material = bpy.data.materials.new("probe")
+        api.set_paint(material, paint)
+        assert api.paint_of(material) != paint  # clamped by the property
