@@ -284,3 +284,48 @@ def test_clean_removes_only_luts_and_weights_nothing_keeps(tmp_path, capsys):
         cleanup.clean(tmp_path, keep=[other])
     assert main(["clean", str(tmp_path / "missing"), "--keep"]) == 2
     assert "no such directory" in _error_line(capsys)
+
+
+# ----------------------------------------------------------------------------- the README's promises
+
+
+def test_the_readme_headless_snippet_gives_the_status_its_comment_promises(tmp_path):
+    pytest.importorskip("bpy")
+    import re
+
+    readme = (ROOT / "README.md").read_text()
+    snippet = next(block for block in re.findall(r"```python\n(.*?)```", readme, re.S) if "api.bake_scene" in block)
+    promised = re.search(r'api\.bake_scene\(.*\)\s*#\s*\{"red paint": "(\w+)"', snippet)
+    assert promised, snippet
+    done = subprocess.run(
+        [sys.executable, "-c", snippet + "\nprint(status)\n"],
+        capture_output=True,
+        text=True,
+        cwd=tmp_path,
+        env={**os.environ, "PYTHONPATH": str(ROOT), "TMPDIR": str(tmp_path)},  # an unsaved file bakes into TMPDIR
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().splitlines()[-1] == repr({"red paint": promised[1]})
+
+
+def test_the_readme_info_command_takes_the_example_luts(tmp_path, capsys, monkeypatch):
+    readme = (ROOT / "README.md").read_text()
+    assert "python -m lut info out/luts/paintlut-*.exr" in readme
+    monkeypatch.chdir(tmp_path)
+    assert main(["example", *SMALL]) == 0
+    capsys.readouterr()
+    files = sorted(str(p) for p in pathlib.Path("out/luts").glob("paintlut-*.exr"))  # as the shell expands it
+    assert len(files) == 3 and main(["info", *files]) == 0
+    assert capsys.readouterr().out.count("(verified)") == 3
+
+
+def test_the_bake_benchmark_writes_no_tracked_file_by_default():
+    sys.path.insert(0, str(ROOT / "scripts"))
+    try:
+        import benchmark
+    finally:
+        sys.path.remove(str(ROOT / "scripts"))
+    plot = benchmark.parse([]).plot
+    tracked = subprocess.run(["git", "ls-files", "--error-unmatch", plot], cwd=ROOT, capture_output=True)
+    assert tracked.returncode != 0, f"{plot} is a tracked file"
+    assert not pathlib.Path(plot).parts[0] == "docs"
