@@ -119,6 +119,36 @@ def test_materials_rendered_through_instances_and_geometry_nodes_are_baked(tmp_p
         assert addon.nodes.group_of(bpy.data.materials[name]) is not None
 
 
+def test_materials_of_a_scene_blender_has_not_evaluated_are_found():
+    """A second scene has no depsgraph in a background session: what its
+    objects reach is still found (instances, Geometry Nodes, a background set)."""
+    new_file()
+    other = bpy.data.scenes.new("other")
+    props = bpy.data.collections.new("props")
+    props.objects.link(triangle("prop", paint_material("instanced")))
+    empty = bpy.data.objects.new("props instance", None)
+    empty.instance_type = "COLLECTION"
+    empty.instance_collection = props
+    other.collection.objects.link(empty)
+    plain = triangle("plain")
+    tree = set_material_tree(paint_material("geonodes"))
+    wrapper = bpy.data.node_groups.new("wrapper", "GeometryNodeTree")  # Set Material one group deeper
+    wrapper.interface.new_socket("Geometry", in_out="INPUT", socket_type="NodeSocketGeometry")
+    wrapper.interface.new_socket("Geometry", in_out="OUTPUT", socket_type="NodeSocketGeometry")
+    inner = wrapper.nodes.new("GeometryNodeGroup")
+    inner.node_tree = tree
+    wrapper.links.new(wrapper.nodes.new("NodeGroupInput").outputs[0], inner.inputs[0])
+    wrapper.links.new(inner.outputs[0], wrapper.nodes.new("NodeGroupOutput").inputs[0])
+    plain.modifiers.new("paint", "NODES").node_group = wrapper
+    other.collection.objects.link(plain)
+    backdrop = bpy.data.scenes.new("backdrop")
+    backdrop.collection.objects.link(triangle("wall", paint_material("backdrop")))
+    other.background_set = backdrop
+    paint_material("spare")
+    assert other.view_layers[0].depsgraph is None
+    assert {m.name for m in api.used_materials([other])} == {"instanced", "geonodes", "backdrop"}
+
+
 # ----------------------------------------------------------------------------- linked library paint
 
 
