@@ -17,7 +17,7 @@ import lut
 import lut.fitting
 from lut import closures, render
 
-from . import nodes, properties
+from . import nodes, properties, validation
 from .properties import working_space
 
 #: LUTs go here, relative to the saved .blend file.
@@ -144,13 +144,13 @@ def set_paint(material, paint: lut.Paint) -> None:
     """Store a paint on a material's settings: a preset by name, another
     spectral paint whole (the Spectral preset), an RGB paint by its fields
     (converted to the scene's working space).  Values outside the panel's
-    limits are refused (``properties.check_paint``), never clamped."""
+    limits are refused (``validation.check_paint_fits``), never clamped."""
     settings = material.paint_lut
     for name in lut.PRESETS:
         if paint == lut.preset(name, paint.space):
             settings.preset = name
             return
-    properties.check_paint(paint)
+    validation.check_paint_fits(paint)
     if paint.spectral:
         settings.spectral_paint = json.dumps(paint.to_dict())
         settings.preset = "SPECTRAL"  # fills the fields with its RGB
@@ -174,8 +174,74 @@ def new_material(name: str, paint: lut.Paint, **options):
 
 
 def used_materials(scenes) -> set:
-    """The materials on the objects of ``scenes``."""
-    return {slot.material for scene in scenes for obj in scene.objects for slot in obj.material_slots if slot.material}
+    """The materials ``scenes`` render (original, not evaluated, data).
+
+    Where Blender has evaluated a view layer (the open scene's), every object
+    instance its depsgraph holds: collection instances, Geometry Nodes' Set
+    Material and instances included.  For every scene, also what its objects
+    reach without evaluation: their slots (hidden objects too), collection
+    instances, the materials and objects a Geometry Nodes modifier's inputs
+    and node tree name, and the background set's objects."""
+    used = set()
+    for scene in scenes:
+        used |= _materials_reached(scene)
+        for view_layer in scene.view_layers:
+            depsgraph = view_layer.depsgraph  # None for a scene Blender has not evaluated
+            if depsgraph is None:
+                continue
+            depsgraph.update()
+            for instance in depsgraph.object_instances:
+                obj = instance.object
+                materials = [slot.material for slot in obj.material_slots]
+                materials += list(getattr(obj.data, "materials", None) or ())
+                used.update(m.original for m in materials if m is not None)
+    return used
+
+
+def _materials_reached(scene) -> set:
+    """The materials a scene's objects reach without evaluating anything."""
+    used, objects, trees = set(), set(), set()
+
+    def visit_id(value):
+        if isinstance(value, bpy.types.Material):
+            used.add(value)
+        elif isinstance(value, bpy.types.Object):
+            visit_object(value)
+        elif isinstance(value, bpy.types.Collection):
+            for obj in value.all_objects:
+                visit_object(obj)
+
+    def visit_tree(tree):
+        if tree is None or tree in trees:
+            return
+        trees.add(tree)
+        for node in tree.nodes:
+            visit_id(getattr(node, "material", None))
+            if node.type == "GROUP":
+                visit_tree(node.node_tree)
+            for socket in node.inputs:
+                if socket.type in ("MATERIAL", "OBJECT", "COLLECTION"):
+                    visit_id(socket.default_value)
+
+    def visit_object(obj):
+        if obj in objects:
+            return
+        objects.add(obj)
+        used.update(slot.material for slot in obj.material_slots if slot.material)
+        if obj.instance_type == "COLLECTION":
+            visit_id(obj.instance_collection)
+        for modifier in obj.modifiers:
+            if modifier.type == "NODES":
+                for key in modifier.keys():
+                    visit_id(modifier[key])
+                visit_tree(modifier.node_group)
+
+    while scene is not None and scene not in objects:
+        objects.add(scene)  # a background-set cycle ends here
+        for obj in scene.objects:
+            visit_object(obj)
+        scene = scene.background_set
+    return used
 
 
 def is_current(material, paint, *, directory=None, exact_metallic=None, **options) -> bool:

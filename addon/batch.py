@@ -1,18 +1,26 @@
 """Headless batch baking of .blend files (for farms; scripts/batch_bake.py).
 
-One file at a time: open it, bake the paint materials its scenes' objects use
-(``api.bake_materials``: unused ones are skipped, up-to-date ones cached),
-and save it atomically when anything was baked.  Every failure is reported
-per item with its reason and never stops the others:
+One file at a time: open it, bake the paint materials it renders (what its
+scenes' depsgraphs evaluate: object slots, collection instances, Geometry
+Nodes' Set Material; ``api.used_materials``) and the paint materials it
+offers as assets, skip unused and up-to-date ones, and save it atomically
+when anything was baked.  Every failure is reported per item with its reason
+and never stops the others:
 
 * a file that is missing or not a .blend fails and is never written;
-* a material whose paint is invalid fails, keeps its previous state, and the
-  file is still saved with the other materials' bakes;
+* a material whose paint is invalid, or whose bake fails in any way, fails
+  alone, keeps its previous state, and the file is still saved with the
+  other materials' bakes;
 * a corrupted or missing LUT or weights file is rebaked.
+
+A material linked from a library is never baked here (Blender does not save
+edits to linked data): it is reported ``linked`` with its library, the file
+to bake it in, and whether the library holds a current bake of it.
 
 Saving writes a temporary file next to the .blend and renames it into place,
 so an interrupted run never leaves a half-written .blend (no .blend1 backup
-either: the old file is replaced only by a complete new one)."""
+either: the old file is replaced only by a complete new one); the file keeps
+its permissions."""
 
 from __future__ import annotations
 
@@ -21,9 +29,10 @@ import pathlib
 
 import bpy
 
-from lut import lutfile
+import lut
+from lut import closures, lutfile
 
-from . import api
+from . import api, nodes
 
 #: The first bytes of a .blend file: plain, gzip (Blender < 3) or zstd compressed.
 _MAGIC = (b"BLENDER", b"\x1f\x8b", b"\x28\xb5\x2f\xfd")
@@ -56,10 +65,89 @@ def _write_blend(filepath):
     bpy.ops.wm.save_as_mainfile(filepath=filepath, copy=True, relative_remap=False)
 
 
+def materials_to_bake(scenes) -> set:
+    """The materials a file must bake: those its scenes render
+    (``api.used_materials``) and its own material assets (an asset kept with
+    a fake user for other files to link is used, here in its own file)."""
+    assets = {m for m in bpy.data.materials if m.library is None and m.asset_data is not None}
+    return api.used_materials(scenes) | assets
+
+
+def _report_name(material) -> str:
+    """A material's key in the report: its name, or for a linked one its
+    name and library ("paint [lib.blend]"), which a local one may share."""
+    return material.name if material.library is None else material.name_full
+
+
+def linked_status(material) -> dict:
+    """The report entry of a material linked from a library: where to bake
+    it and whether that library holds a current bake (the settings are not
+    stale, and the LUT, both weights files and the node groups are there and
+    verified)."""
+    library = pathlib.Path(bpy.path.abspath(material.library.filepath)).resolve()
+    settings = material.paint_lut
+    baked = False
+    if not settings.stale and settings.lut_path:
+        path = pathlib.Path(bpy.path.abspath(settings.lut_path, library=material.library))
+        try:
+            lut.load_lut(path)
+            for target in closures.TARGETS:
+                lutfile.read_exr(closures.weights_path(path, target))
+            baked = all(nodes.group_of(material, target) is not None for target in closures.TARGETS)
+        except lut.LUTError:
+            baked = False
+    reason = f"linked from {library}: bake it there (batch_bake.py {library})"
+    if not baked:
+        reason = f"not baked in its library; {reason}"
+    return {"status": "linked", "library": str(library), "baked": baked, "reason": reason}
+
+
+def bake_one(material, used, force=False, **options) -> dict:
+    """Bake one paint material if it is used and not current; its report
+    entry.  Any exception fails this material alone, with its reason."""
+    if material.library is not None:
+        return linked_status(material) if material in used else {"status": "unused"}
+    if material not in used:
+        return {"status": "unused"}
+    try:
+        paint = api.paint_of(material)
+        if not force and api.is_current(material, paint, **options):
+            return {"status": "cached", **_fit_entry(material)}
+        result = api.bake_material(material, force=force, **options)
+    except (ValueError, OSError, RuntimeError) as exc:
+        return {"status": "failed", "reason": str(exc).strip() or type(exc).__name__}
+    except Exception as exc:  # a defect must not cost the file its other bakes
+        return {"status": "failed", "reason": f"{type(exc).__name__}: {exc}"}
+    return {"status": "baked", "computed": list(result.computed), **_fit_entry(material)}
+
+
+def _fit_entry(material) -> dict:
+    """The paint type's LUT key (materials with one key shared one bake) and
+    each engine's fit error at the material's colours, with its target."""
+    entry = {"type": pathlib.Path(material.paint_lut.lut_path).stem.removeprefix("paintlut-")}
+    errors = api.fit_errors(material)
+    entry["fit"] = {t: {"error": round(e, 5), "target": g} for t, (e, g) in errors.items()}
+    misses = [f"{t.title()} {100 * e:.1f}% > {100 * g:.0f}%" for t, (e, g) in errors.items() if e > g]
+    if misses:
+        entry["fit_misses"] = misses
+    return entry
+
+
+def shared_bakes(materials: dict) -> dict:
+    """{LUT key: [material names]} for the paint types that several of a
+    file's materials share (baked once, the others found it cached)."""
+    groups = {}
+    for name, m in materials.items():
+        if m.get("type"):
+            groups.setdefault(m["type"], []).append(name)
+    return {key: names for key, names in groups.items() if len(names) > 1}
+
+
 def bake_file(path, force=False, pack=False, **options) -> dict:
     """Bake one .blend file.  Returns its report entry: {"file", "status"
     ("saved", "unchanged" or "failed"), "reason" (when failed), "materials":
-    {name: {"status": "baked" | "cached" | "unused" | "failed", "reason"}}}."""
+    {name: {"status": "baked" | "cached" | "unused" | "linked" | "failed",
+    "reason", and for linked ones "library" and "baked"}}}.  Never raises."""
     path = pathlib.Path(path).resolve()
     entry = {"file": str(path), "materials": {}}
     try:
@@ -68,10 +156,17 @@ def bake_file(path, force=False, pack=False, **options) -> dict:
     except (ValueError, RuntimeError) as exc:
         entry.update(status="failed", reason=str(exc).strip())
         return entry
-    status = api.bake_materials(api.used_materials(bpy.data.scenes), force=force, **options)
-    for name, text in status.items():
-        kind, _, reason = text.partition(": ")
-        entry["materials"][name] = {"status": kind, **({"reason": reason} if reason else {})}
+    try:
+        used = materials_to_bake(bpy.data.scenes)
+    except Exception as exc:  # the file cannot be evaluated: nothing is baked or saved
+        entry.update(status="failed", reason=f"cannot find the materials it uses: {type(exc).__name__}: {exc}")
+        return entry
+    for material in list(bpy.data.materials):
+        if material.paint_lut.enabled:
+            entry["materials"][_report_name(material)] = bake_one(material, used, force=force, **options)
+    shared = shared_bakes(entry["materials"])
+    if shared:
+        entry["shared"] = shared
     baked = any(m["status"] == "baked" for m in entry["materials"].values())
     if baked or pack:
         try:
@@ -82,20 +177,24 @@ def bake_file(path, force=False, pack=False, **options) -> dict:
         entry["status"] = "saved"
     else:
         entry["status"] = "unchanged"
-    if any(m["status"] == "failed" for m in entry["materials"].values()):
-        entry["reason"] = "some materials failed"
+    if any(_failed(m) for m in entry["materials"].values()):
+        entry["reason"] = "some materials failed or are not baked in their library"
     return entry
 
 
+def _failed(material_entry) -> bool:
+    status = material_entry["status"]
+    return status == "failed" or (status == "linked" and not material_entry.get("baked"))
+
+
 def failed(entries) -> bool:
-    """Whether any file or material of a report failed."""
-    return any(
-        e["status"] == "failed" or any(m["status"] == "failed" for m in e["materials"].values()) for e in entries
-    )
+    """Whether any file or material of a report failed (a linked material
+    whose library holds no current bake renders unbaked: that fails too)."""
+    return any(e["status"] == "failed" or any(_failed(m) for m in e["materials"].values()) for e in entries)
 
 
 def summary(entries) -> str:
-    """One line per file (its status and material counts), one per failed material."""
+    """One line per file (its status and material counts), one per failed or linked material."""
     lines = []
     for entry in entries:
         counts = {}
@@ -106,6 +205,10 @@ def summary(entries) -> str:
             f"{entry['file']}: {entry['status']} ({text})" + (f": {entry['reason']}" if "reason" in entry else "")
         )
         for name, m in entry["materials"].items():
-            if m["status"] == "failed":
-                lines.append(f"  {name}: failed: {m['reason']}")
+            if m["status"] in ("failed", "linked"):
+                lines.append(f"  {name}: {m['status']}: {m['reason']}")
+            if m.get("fit_misses"):
+                lines.append(f"  {name}: fit misses its target: {', '.join(m['fit_misses'])}")
+        for key, names in entry.get("shared", {}).items():
+            lines.append(f"  one bake of paint type {key[:12]} shared by {', '.join(names)}")
     return "\n".join(lines)

@@ -98,19 +98,6 @@ def set_fields(settings, paint: lut.Paint) -> None:
         _applying_preset = False
 
 
-def check_paint(paint: lut.Paint) -> None:
-    """Refuse a paint that the settings cannot hold as it is (they would
-    clamp it to a different paint): raises ValueError naming the field and
-    its allowed range."""
-    props = PaintLUTSettings.bl_rna.properties
-    values = {"n": float(paint.index_at(lut.paint.REFERENCE_WAVELENGTH)), "g": paint.g, "slope": paint.slope,
-              "facet": paint.facet}  # fmt: skip
-    for name, value in values.items():
-        low, high = props[name].hard_min, props[name].hard_max
-        if not low <= value <= high:
-            raise ValueError(f"{name} must lie in [{low:g}, {high:g}] on a material, got {value!r}")
-
-
 @functools.lru_cache(maxsize=32)
 def _spectral_inputs(paint_json: str):
     return lut.render.node_inputs(lut.Paint.from_dict(json.loads(paint_json)))

@@ -2,25 +2,42 @@
 
     python -m lut example [--out DIR]         bake the three presets, draw the paper's figures
     python -m lut bake --preset NAME [...]    bake one paint into a LUT file
-    python -m lut info FILE                   describe a LUT file
+    python -m lut info FILE [FILE ...]        describe LUT files
+    python -m lut clean DIR --keep FILE ...   remove the LUTs and weights in DIR that nothing uses
 
-Errors are reported as one line on standard error, with exit status 2."""
+Errors are reported as one line on standard error, with exit status 2
+(130 when interrupted with Ctrl-C)."""
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
+import math
+import os
 import pathlib
 import sys
 import time
 import tomllib
 
-from . import __version__, baking, colour_management, examples, figures, lutfile, presets, table
+from . import __version__, baking, cleanup, colour_management, examples, figures, lutfile, presets, table
 from .baking import BAKE_SINGLE_NODES
 from .models.rough import DIFFUSE_NODES
 from .paint import Paint
 
 DEFAULT_OUT = "out"
+#: The largest LUT the command line bakes: N_u * N_theta_d * N_phi_d nodes
+#: (256 x 128 x 128; a 50 MB file, about 150 MB of memory while baking).
+MAX_NODES = 256 * 128 * 128
+#: The largest quadrature size per axis (the defaults are 3 to 6).
+MAX_QUADRATURE = 64
+#: The paint parameters the command line accepts, as the Blender panel's:
+#: outside them the models overflow or the LUT cannot resolve the lobe.
+INDEX_RANGE = (1.0, 4.0)
+SLOPE_RANGE = (0.0, 3.0)
+#: The smallest non-zero slope: a narrower facet lobe than this is not
+#: resolved by any LUT resolution the command line bakes (use 0 for smooth).
+MIN_ROUGH_SLOPE = 1e-3
 
 
 def _progress_bar(label):
@@ -56,37 +73,92 @@ def _bake_one(paint, out, args, label):
     return path, time.perf_counter() - start
 
 
-def _paint_from_args(args) -> Paint:
-    if args.preset:
-        return presets.preset(args.preset, args.space or colour_management.DEFAULT_SPACE)
-    if args.paint:
-        path = pathlib.Path(args.paint)
-        try:
-            text = path.read_text()
-        except OSError as exc:
-            raise ValueError(f"cannot read paint file {str(path)!r}: {exc.strerror}") from None
-        try:
-            data = tomllib.loads(text) if path.suffix.lower() == ".toml" else json.loads(text)
-        except (tomllib.TOMLDecodeError, json.JSONDecodeError) as exc:
-            raise ValueError(
-                f"paint file {str(path)!r} is not valid {path.suffix[1:].upper() or 'JSON'}: {exc}"
-            ) from None
-        if args.space:
-            data = {**data, "space": args.space}
-        return Paint.from_dict(data)
+_OVERRIDES = ("n", "rho", "single", "g", "slope", "distribution", "facet", "space")
+
+
+def _overrides(args) -> dict:
+    """The paint fields given as options."""
     fields = {}
-    for key in ("n", "g", "slope", "distribution", "facet", "space"):
+    for key in _OVERRIDES:
         value = getattr(args, key)
-        if value is not None:
-            fields[key] = value
-    for key in ("rho", "single"):
-        value = getattr(args, key)
-        if value is not None:
-            fields[key] = value[0] if len(value) == 1 else value
-    return Paint(**fields)
+        if value is None:
+            continue
+        if key in ("rho", "single"):
+            value = value[0] if len(value) == 1 else tuple(value)
+        fields[key] = value
+    return fields
+
+
+def _read_paint_file(path: pathlib.Path) -> dict:
+    try:
+        raw = path.read_bytes()
+    except OSError as exc:
+        raise ValueError(f"cannot read paint file {str(path)!r}: {exc.strerror}") from None
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"paint file {str(path)!r} is not UTF-8 text (byte {exc.start})") from None
+    kind = "TOML" if path.suffix.lower() == ".toml" else "JSON"
+    try:
+        data = tomllib.loads(text) if kind == "TOML" else json.loads(text)
+    except (tomllib.TOMLDecodeError, json.JSONDecodeError, RecursionError) as exc:
+        raise ValueError(f"paint file {str(path)!r} is not valid {kind}: {exc}") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"paint file {str(path)!r} must hold a table/object of paint fields")
+    return data
+
+
+def _paint_from_args(args) -> Paint:
+    """The paint of a preset or a paint file with the options as overrides,
+    or of the options alone."""
+    fields = _overrides(args)
+    if args.preset:
+        paint = presets.preset(args.preset, args.space or colour_management.DEFAULT_SPACE)
+        paint = dataclasses.replace(paint, **fields) if fields else paint
+    elif args.paint:
+        path = pathlib.Path(args.paint)
+        data = _read_paint_file(path)
+        try:
+            paint = Paint.from_dict({**data, **fields})
+        except ValueError as exc:
+            raise ValueError(f"paint file {str(path)!r}: {exc}") from None
+    else:
+        paint = Paint(**fields)
+    _check_limits(paint)
+    return paint
+
+
+def _check_limits(paint: Paint) -> None:
+    """The command line's limits (INDEX_RANGE, SLOPE_RANGE): beyond them the
+    models overflow or the LUT cannot resolve the facet lobe."""
+    low, high = INDEX_RANGE
+    indices = [paint.index_at(wl) for wl in (380.0, 780.0)] if paint.dispersive else [paint.n]
+    for n in indices:
+        if not low <= n <= high:
+            raise ValueError(f"n must be in [{low:g}, {high:g}], got {n:g}")
+    low, high = SLOPE_RANGE
+    if not (paint.slope == 0.0 or MIN_ROUGH_SLOPE <= paint.slope <= high):
+        raise ValueError(f"slope must be 0 (smooth) or in [{MIN_ROUGH_SLOPE:g}, {high:g}], got {paint.slope:g}")
+
+
+def _check_sizes(args) -> None:
+    """Resolution and quadrature sizes the machine can bake."""
+    if args.resolution is not None:
+        nodes = math.prod(args.resolution)
+        if any(r < 2 for r in args.resolution) or nodes > MAX_NODES:
+            raise ValueError(
+                f"--resolution must be three whole numbers >= 2 with a product N_u*N_theta_d*N_phi_d of at most "
+                f"{MAX_NODES} (e.g. 256 128 128), got {' '.join(map(str, args.resolution))} ({nodes} nodes)"
+            )
+    for key in ("single_nodes", "diffuse_nodes"):
+        value = getattr(args, key, None)
+        if value is not None and not all(1 <= v <= MAX_QUADRATURE for v in value):
+            option = "--" + key.replace("_", "-")
+            raise ValueError(f"{option} must be two whole numbers in [1, {MAX_QUADRATURE}], got {list(value)}")
 
 
 def _cmd_bake(args) -> int:
+    _check_sizes(args)
     paint = _paint_from_args(args)
     path, seconds = _bake_one(paint, args.out, args, paint.name or "bake")
     print(f"{path}  ({seconds:.2f} s)")
@@ -94,26 +166,52 @@ def _cmd_bake(args) -> int:
 
 
 def _cmd_info(args) -> int:
-    _, header = lutfile.read(args.file)  # verifies the content hash
+    status = 0
+    for i, file in enumerate(args.file):
+        try:
+            _, header = lutfile.read(file)  # verifies the content hash
+        except (ValueError, OSError) as exc:
+            if len(args.file) == 1:
+                raise
+            print(f"error: {exc}", file=sys.stderr)
+            status = 2
+            continue
+        if i:
+            print()
+        _print_info(file, header)
+    return status
+
+
+def _print_info(file, header) -> None:
     meta = header["meta"]
     width, height, channels = header["size"]
-    print(f"{args.file}: Paint LUT format {meta['format']}, {width}x{height} pixels, {channels} channels (Non-Color)")
-    print(f"  working space   {meta['space']}")
+    print(f"{file}: Paint LUT format {meta['format']}, {width}x{height} pixels, {channels} channels (Non-Color)")
+    print(f"  components      {', '.join(meta['components'])} (tiles: {meta['tiles']})")
+    print(f"  internal refl.  {meta['internal_reflectance']:.6f} (r-bar: k(rho) = rho (1 - r-bar)/(1 - rho r-bar))")
     print(f"  resolution      {meta['resolution']} (N_u, N_theta_d, N_phi_d)")
     print(f"  parameterization {meta['parameterization']}")
     for key in ("single_nodes", "diffuse_nodes"):
         if key in meta:
             print(f"  {key:15} {meta[key]}")
     print(f"  content hash    {header['hash']} (verified)")
-    print("  paint:")
-    for key, value in meta["paint"].items():
+    print("  paint type (every colour of it shares this LUT):")
+    for key, value in meta["type"].items():
         if isinstance(value, dict):
             value = f"spectrum {value.get('spectrum')!r}"
         print(f"    {key:12} {value}")
+
+
+def _cmd_clean(args) -> int:
+    removed = cleanup.clean(args.directory, keep=args.keep, dry_run=args.dry_run)
+    verb = "would remove" if args.dry_run else "removed"
+    for path in removed:
+        print(f"{verb} {path}")
+    print(f"{verb} {len(removed)} file(s) from {args.directory}")
     return 0
 
 
 def _cmd_example(args) -> int:
+    _check_sizes(args)
     out = pathlib.Path(args.out)
     data = examples.fig2_glossy_white(theta_s_deg=[-60, -30, 0, 30, 60, 80])
     print("Glossy white paint (paper Fig. 2 left), theta_i = 60 deg, in plane, 45-degree light:")
@@ -182,8 +280,20 @@ def main(argv=None) -> int:
     )
     bake_options(b)
 
-    info = sub.add_parser("info", help="print a LUT file's metadata (and verify its content hash)")
-    info.add_argument("file")
+    info = sub.add_parser("info", help="print LUT files' metadata (and verify their content hashes)")
+    info.add_argument("file", nargs="+")
+
+    clean = sub.add_parser(
+        "clean",
+        help="remove the LUTs and weights files in a directory that nothing uses",
+        description="Remove from DIR the LUT files (paintlut-*.exr) not given with --keep, their closure weights "
+        "(paintfit-*.exr), and the temporary files of interrupted writes.  Other files are never touched.",
+    )
+    clean.add_argument("directory", metavar="DIR")
+    clean.add_argument(
+        "--keep", nargs="*", default=[], metavar="FILE", help="LUT files still in use (kept with their weights)"
+    )
+    clean.add_argument("--dry-run", action="store_true", help="only list what would be removed")
 
     args = parser.parse_args(argv)
     if args.command == "bake":
@@ -197,12 +307,44 @@ def main(argv=None) -> int:
                         parser.error(f"--{key} takes one grey value, three RGB values or one spectrum")
             elif value is not None:
                 parser.error(f"--{key} takes one grey value, three RGB values or one spectrum")
+    command = {"example": _cmd_example, "bake": _cmd_bake, "info": _cmd_info, "clean": _cmd_clean}[args.command]
     try:
-        return {"example": _cmd_example, "bake": _cmd_bake, "info": _cmd_info}[args.command](args)
+        return command(args)
     except (ValueError, OSError) as exc:
+        if isinstance(exc, BrokenPipeError):
+            return _broken_pipe()
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+
+
+def _broken_pipe() -> int:
+    """The reader of our output went away (``... | head``): stop quietly.
+    Python would report the failed flush of stdout at exit; point it at
+    /dev/null first."""
+    try:
+        with open(os.devnull, "w") as devnull:
+            os.dup2(devnull.fileno(), sys.stdout.fileno())
+    except (AttributeError, OSError, ValueError):
+        pass  # stdout is not a file (tests)
+    return 141  # as a shell reports a process ended by SIGPIPE
+
+
+def run() -> int:
+    """``main`` with the output flushed while a closed pipe can still be
+    handled (``python -m lut info ... | head``)."""
+    try:
+        status = main()
+        sys.stdout.flush()
+    except BrokenPipeError:
+        return _broken_pipe()
+    except KeyboardInterrupt:  # outside a command: while importing or parsing
+        print("interrupted", file=sys.stderr)
+        return 130
+    return status
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(run())

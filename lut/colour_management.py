@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import csv
 import functools
+import math
 import pathlib
 
 import numpy as np
@@ -42,7 +43,7 @@ def _colour():
 
 def working_space(name: str) -> str:
     """Validate a working-space name."""
-    if name not in WORKING_SPACES:
+    if not isinstance(name, str) or name not in WORKING_SPACES:
         allowed = ", ".join(repr(k) for k in WORKING_SPACES)
         raise ValueError(f"space must be one of {allowed}, got {name!r}")
     return name
@@ -115,8 +116,15 @@ class Spectrum:
     outside the given range are held at the end values."""
 
     def __init__(self, source, values=None, *, name=None, scale=1.0):
+        if isinstance(scale, bool) or not isinstance(scale, (int, float, np.floating, np.integer)):
+            raise ValueError(f"spectrum scale must be a finite number >= 0, got {scale!r}")
+        if not (math.isfinite(scale) and scale >= 0):
+            raise ValueError(f"spectrum scale must be a finite number >= 0, got {scale!r}")
         if values is not None:
-            wl, val = np.asarray(source, dtype=float), np.asarray(values, dtype=float)
+            try:
+                wl, val = np.asarray(source, dtype=float), np.asarray(values, dtype=float)
+            except (TypeError, ValueError):
+                raise ValueError("spectrum wavelengths and values must be lists of numbers") from None
             label = name or "array"
         elif isinstance(source, (str, pathlib.Path)) and str(source).lower().endswith(".csv"):
             wl, val = _read_csv(pathlib.Path(source))
@@ -136,6 +144,12 @@ class Spectrum:
             raise ValueError(f"spectrum {label!r}: wavelengths must increase and match the values")
         if not (np.all(np.isfinite(val)) and np.all(np.isfinite(wl))):
             raise ValueError(f"spectrum {label!r}: values must be finite")
+        if wl[-1] <= WAVELENGTHS[0] or wl[0] >= WAVELENGTHS[-1]:
+            hint = " (micrometres? give nanometres)" if wl[-1] < 10 else ""
+            raise ValueError(
+                f"spectrum {label!r}: wavelengths must be in nm and overlap {WAVELENGTHS[0]:g}-{WAVELENGTHS[-1]:g} nm, "
+                f"got {wl[0]:g}-{wl[-1]:g}{hint}"
+            )
         self.name = label
         self.values = np.interp(WAVELENGTHS, wl, val) * float(scale)
         self.values.setflags(write=False)
@@ -168,10 +182,14 @@ class Spectrum:
 
 def _read_csv(path: pathlib.Path):
     try:
-        with path.open(newline="") as fh:
+        with path.open(newline="", encoding="utf-8") as fh:
             rows = [r for r in csv.reader(fh) if r and not r[0].lstrip().startswith("#")]
     except OSError as exc:
         raise ValueError(f"cannot read spectrum file {str(path)!r}: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"spectrum file {str(path)!r} is not UTF-8 text (byte {exc.start})") from None
+    except csv.Error as exc:
+        raise ValueError(f"spectrum file {str(path)!r} is not CSV: {exc}") from None
     try:
         data = np.array([[float(r[0]), float(r[1])] for r in rows if _is_number(r[0])])
     except (ValueError, IndexError):

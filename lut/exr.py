@@ -72,7 +72,10 @@ def write(path, image: np.ndarray, names=("R", "G", "B"), attributes=None) -> No
 
 def _parse_attr(kind, value):
     if kind == "string":
-        return value.decode("utf-8", "replace")
+        try:
+            return value.decode("utf-8")
+        except UnicodeDecodeError:
+            raise EXRError("a string attribute is not UTF-8") from None
     if kind == "int":
         return struct.unpack("<i", value)[0]
     if kind == "float":
@@ -94,47 +97,69 @@ def _parse_attr(kind, value):
 
 def read(path):
     """(pixels (height, width, channels) float32 in the order R, G, B, A then
-    others, channel names, attributes) of an EXR file; raises EXRError."""
+    others, channel names, attributes) of an EXR file; raises EXRError for
+    anything that is not a whole, well-formed image of the kind ``write``
+    makes (or OpenImageIO's ZIP/ZIPS float images)."""
     with open(path, "rb") as fh:
         data = fh.read()
     try:
-        magic, version = struct.unpack_from("<ii", data, 0)
-        if magic != MAGIC:
-            raise EXRError(f"{path}: not an EXR file")
-        if version & 0x1A00:  # tiled, deep or multi-part (long names are fine)
-            raise EXRError(f"{path}: only single-part scanline EXR files are read without OpenImageIO")
-        attrs, at = {}, 8
-        while data[at] != 0:
-            name_end = data.index(b"\0", at)
-            kind_end = data.index(b"\0", name_end + 1)
-            size = struct.unpack_from("<i", data, kind_end + 1)[0]
-            value = data[kind_end + 5 : kind_end + 5 + size]
-            attrs[data[at:name_end].decode()] = _parse_attr(data[name_end + 1 : kind_end].decode(), value)
-            at = kind_end + 5 + size
-        at += 1
-        x0, y0, x1, y1 = attrs["dataWindow"]
-        width, height = x1 - x0 + 1, y1 - y0 + 1
-        channels = attrs["channels"]
-        compression = attrs["compression"]
-        if compression not in _LINES or any(t != _FLOAT for _, t in channels):
-            raise EXRError(f"{path}: only 32-bit float, uncompressed or ZIP EXR files are read without OpenImageIO")
-        lines = _LINES[compression]
-        chunks = -(-height // lines)
-        offsets = struct.unpack_from(f"<{chunks}Q", data, at)
-        rows = []
-        for offset in offsets:
-            y, size = struct.unpack_from("<ii", data, offset)
-            block = data[offset + 8 : offset + 8 + size]
-            n = min(lines, y1 - y + 1)
-            raw = n * len(channels) * width * 4
-            if compression != _NO_COMPRESSION and size < raw:
-                block = _unzip(block)
-            if len(block) != raw:
-                raise EXRError(f"{path}: truncated pixel data")
-            rows.append(np.frombuffer(block, dtype="<f4").reshape(n, len(channels), width))
-    except (struct.error, IndexError, KeyError, zlib.error) as exc:
-        raise EXRError(f"{path}: damaged or truncated EXR file ({exc})") from None
-    planar = np.concatenate(rows)[:height]  # (height, channel, width), channels sorted by name
+        return _decode(data)
+    except EXRError as exc:
+        raise EXRError(f"{path}: {exc}") from None
+    except (struct.error, IndexError, KeyError, TypeError, ValueError, OverflowError, zlib.error) as exc:
+        raise EXRError(f"{path}: damaged or truncated EXR file ({type(exc).__name__}: {exc})") from None
+
+
+def _decode(data: bytes):
+    magic, version = struct.unpack_from("<ii", data, 0)
+    if magic != MAGIC:
+        raise EXRError("not an EXR file")
+    if version & 0x1A00:  # tiled, deep or multi-part (long names are fine)
+        raise EXRError("only single-part scanline EXR files are read without OpenImageIO")
+    attrs, at = {}, 8
+    while data[at] != 0:
+        name_end = data.index(b"\0", at)
+        kind_end = data.index(b"\0", name_end + 1)
+        size = struct.unpack_from("<i", data, kind_end + 1)[0]
+        if size < 0 or kind_end + 5 + size > len(data):
+            raise EXRError("an attribute runs past the end of the file")
+        value = data[kind_end + 5 : kind_end + 5 + size]
+        attrs[data[at:name_end].decode()] = _parse_attr(data[name_end + 1 : kind_end].decode(), value)
+        at = kind_end + 5 + size
+    at += 1
+    x0, y0, x1, y1 = attrs["dataWindow"]
+    width, height = x1 - x0 + 1, y1 - y0 + 1
+    channels = attrs["channels"]
+    compression = attrs["compression"]
+    if compression not in _LINES or any(t != _FLOAT for _, t in channels):
+        raise EXRError("only 32-bit float, uncompressed or ZIP EXR files are read without OpenImageIO")
+    if width < 1 or height < 1 or not channels:
+        raise EXRError(f"empty image ({width}x{height}, {len(channels)} channels)")
+    lines = _LINES[compression]
+    chunks = -(-height // lines)
+    if at + 8 * chunks > len(data):
+        raise EXRError("truncated scanline offset table")
+    offsets = struct.unpack_from(f"<{chunks}Q", data, at)
+    line_bytes = len(channels) * width * 4
+    rows = [None] * chunks
+    for offset in offsets:
+        if offset > len(data) - 8:
+            raise EXRError("a scanline offset points past the end of the file")
+        y, size = struct.unpack_from("<ii", data, offset)
+        index, remainder = divmod(y - y0, lines)
+        if remainder or not 0 <= index < chunks or rows[index] is not None:
+            raise EXRError(f"unexpected scanline {y}")
+        if size < 0 or offset + 8 + size > len(data):
+            raise EXRError("truncated pixel data")
+        block = data[offset + 8 : offset + 8 + size]
+        n = min(lines, y1 - y + 1)
+        raw = n * line_bytes
+        if compression != _NO_COMPRESSION and size < raw:
+            block = _unzip(block, raw)
+        if len(block) != raw:
+            raise EXRError("truncated pixel data")
+        rows[index] = np.frombuffer(block, dtype="<f4").reshape(n, len(channels), width)
+    planar = np.concatenate(rows)  # (height, channel, width), channels sorted by name
     names = [name for name, _ in channels]
     rank = {"R": 0, "G": 1, "B": 2, "A": 3}
     order = sorted(range(len(names)), key=lambda c: (rank.get(names[c], 4), names[c]))
@@ -142,9 +167,15 @@ def read(path):
     return pixels, [names[c] for c in order], attrs
 
 
-def _unzip(block: bytes) -> bytes:
-    """Undo OpenEXR's ZIP: inflate, undo the byte delta, re-interleave the two halves."""
-    t = np.frombuffer(zlib.decompress(block), dtype=np.uint8)
+def _unzip(block: bytes, size: int) -> bytes:
+    """Undo OpenEXR's ZIP: inflate (to at most ``size`` bytes: a damaged
+    stream cannot claim unbounded memory), undo the byte delta, re-interleave
+    the two halves."""
+    inflate = zlib.decompressobj()
+    t = inflate.decompress(block, size)
+    if inflate.unconsumed_tail or not inflate.eof:
+        raise EXRError("damaged compressed pixel data")
+    t = np.frombuffer(t, dtype=np.uint8)
     t = np.cumsum(t.astype(np.int64) - 128 * (np.arange(t.size) > 0)) & 0xFF
     t = t.astype(np.uint8)
     half = (t.size + 1) // 2

@@ -18,16 +18,25 @@ Header attributes:
   paintlut:key     SHA-256 of the canonical meta JSON: the cache key
   paintlut:hash    SHA-256 of the meta JSON and the pixel bytes: detects a
                    file whose content was altered
+
+Other images written by ``write_exr`` (closure weights) carry a
+``paintlut:hash`` of their other ``paintlut:`` attributes and pixels.  Every
+malformed file, whatever the damage, raises LUTError naming it.
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import hashlib
 import json
 import os
 import pathlib
+import re
+import socket
+import stat
 import tempfile
+import time
 
 import numpy as np
 
@@ -76,31 +85,57 @@ def _write_image(path, image, attributes):
         raise OSError(f"cannot write {path}: {oiio.geterror()}")
 
 
-def _read_image(path, keys=(), what="file"):
+def _read_image(path, keys=(), what="file", prefix=None):
     """(pixels (height, width, channels) float32, {key: attribute or None})
-    of an EXR file; raises LUTError when it cannot be read."""
+    of an EXR file, with every attribute whose name starts with ``prefix``
+    added; raises LUTError, naming the file, for anything that cannot be read."""
     path = pathlib.Path(path)
     if not path.is_file():
         raise LUTError(f"{path}: no such {what}")
+    try:
+        return _read_any(path, keys, prefix)
+    except LUTError:
+        raise
+    except OSError as exc:
+        raise LUTError(f"{path}: cannot read the {what}: {exc.strerror or exc}") from None
+    except Exception as exc:  # a damaged file must never surface as another error
+        raise LUTError(f"{path}: not a readable EXR image (damaged file?): {type(exc).__name__}: {exc}") from None
+
+
+def _read_any(path, keys, prefix):
     oiio = _oiio()
     if oiio is None:
         try:
             pixels, _, attrs = exr.read(path)
-        except (exr.EXRError, OSError) as exc:
-            raise LUTError(f"{path}: not a readable EXR image (truncated or corrupt?): {exc}") from None
-        return pixels, {key: attrs.get(key) for key in keys}
+        except exr.EXRError as exc:
+            raise LUTError(f"not a readable EXR image (truncated or corrupt?): {exc}") from None  # exc names the file
+        found = {key: attrs.get(key) for key in keys}
+        if prefix:
+            found.update((k, v) for k, v in attrs.items() if k.startswith(prefix))
+        return pixels, found
     inp = oiio.ImageInput.open(str(path))
     if inp is None:
         raise LUTError(f"{path}: not a readable EXR image (truncated or corrupt?): {oiio.geterror()}")
     try:
         spec = inp.spec()
-        attrs = {key: spec.getattribute(key) for key in keys}
+        attrs = {key: _attribute(spec, key, path) for key in keys}
+        if prefix:
+            names = [p.name for p in spec.extra_attribs if p.name.startswith(prefix)]
+            attrs.update((name, _attribute(spec, name, path)) for name in names)
         pixels = inp.read_image(oiio.FLOAT)
+        error = inp.geterror()
     finally:
         inp.close()
-    if pixels is None or np.ndim(pixels) != 3:
-        raise LUTError(f"{path}: pixel data cannot be read (truncated file?): {oiio.geterror()}")
+    if pixels is None or np.ndim(pixels) != 3 or error:
+        raise LUTError(f"{path}: pixel data cannot be read (truncated file?): {error or oiio.geterror()}")
     return np.asarray(pixels, dtype=np.float32), attrs
+
+
+def _attribute(spec, key, path):
+    try:
+        return spec.getattribute(key)
+    except UnicodeDecodeError:
+        raise LUTError(f"{path}: its attribute {key} is not UTF-8 text (damaged file)") from None
 
 
 def canonical_json(meta: dict) -> str:
@@ -123,19 +158,99 @@ def _to_image(table: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(table.reshape(-1, n_u, c), dtype=np.float32)
 
 
+#: A partial file from a writer that cannot be asked whether it still runs
+#: (another host, or no process ids) is stale after this many seconds.
+STALE_PARTIAL_SECONDS = 24 * 3600
+
+_PARTIAL = re.compile(r"^\..*?\.(?:(?P<pid>\d+)@(?P<host>[A-Za-z0-9_-]*)\.)?[A-Za-z0-9_]+\.partial(?:\.[^.]*)?$")
+
+
+def _host() -> str:
+    return re.sub(r"[^A-Za-z0-9_-]", "_", socket.gethostname())[:64]
+
+
+def _process_alive(pid: int) -> bool:
+    if os.name != "posix":  # os.kill would terminate the process on Windows
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError):
+        return True
+    return True
+
+
+def is_stale_partial(path, now=None) -> bool:
+    """Whether ``path`` is the temporary file of an atomic write whose writer
+    is gone: a process of this host that no longer runs (killed, crashed),
+    or, for another host's, older than STALE_PARTIAL_SECONDS."""
+    path = pathlib.Path(path)
+    match = _PARTIAL.match(path.name)
+    if match is None:
+        return False
+    try:
+        age = (time.time() if now is None else now) - path.stat().st_mtime
+    except OSError:
+        return False
+    if match["pid"] and match["host"] == _host():
+        return not _process_alive(int(match["pid"]))
+    return age > STALE_PARTIAL_SECONDS
+
+
+def remove_stale_partials(directory) -> list[pathlib.Path]:
+    """Remove the temporary files that interrupted atomic writes left in
+    ``directory`` (``is_stale_partial``); returns them."""
+    removed = []
+    try:
+        candidates = sorted(pathlib.Path(directory).glob(".*.partial*"))
+    except OSError:
+        return removed
+    for candidate in candidates:
+        if candidate.is_file() and is_stale_partial(candidate):
+            with contextlib.suppress(FileNotFoundError):
+                candidate.unlink()
+                removed.append(candidate)
+    return removed
+
+
+def _new_file_mode() -> int:
+    """The mode a plain open() would give a new file (0o666 less the umask)."""
+    try:
+        with open("/proc/self/status") as fh:
+            umask = next(int(line.split()[1], 8) for line in fh if line.startswith("Umask:"))
+    except (OSError, StopIteration, ValueError, IndexError):
+        umask = os.umask(0o022)
+        os.umask(umask)
+    return 0o666 & ~umask
+
+
 @contextlib.contextmanager
 def atomic_target(path):
     """Write a file atomically: yields a temporary path in the same directory
     (same suffix, so writers that go by the extension work) that is renamed
     onto ``path`` when the block succeeds and removed when it fails, so an
-    interrupted write never leaves a partial file and never loses the old one."""
+    interrupted write never leaves a partial file and never loses the old one.
+    The file keeps the permissions of the one it replaces (a new one gets
+    the umask's).  The temporary file's name holds this process's id and
+    host, so a later write in the directory can remove it if the process was
+    killed (``remove_stale_partials``)."""
     path = pathlib.Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=f".partial{path.suffix}")
+    remove_stale_partials(path.parent)
+    try:
+        mode = stat.S_IMODE(path.stat().st_mode)
+    except FileNotFoundError:
+        mode = _new_file_mode()
+    fd, tmp = tempfile.mkstemp(
+        dir=path.parent, prefix=f".{path.stem}.{os.getpid()}@{_host()}.", suffix=f".partial{path.suffix}"
+    )
     os.close(fd)
     try:
         yield tmp
-        os.chmod(tmp, 0o644)
+        os.chmod(tmp, mode)
         os.replace(tmp, path)
     finally:
         with contextlib.suppress(FileNotFoundError):
@@ -152,17 +267,28 @@ def atomic_write_bytes(path, data: bytes) -> pathlib.Path:
 def write_exr(path, image: np.ndarray, attributes: dict) -> pathlib.Path:
     """Write a float32 (height, width, 3) image with string/int attributes
     atomically: to a temporary file in the same directory, renamed into
-    place, so an interrupted write never leaves a partial file under ``path``."""
+    place, so an interrupted write never leaves a partial file under ``path``.
+    Unless given, a ``paintlut:hash`` of the attributes and pixels is added,
+    which ``read_exr`` verifies."""
     path = pathlib.Path(path)
     image = np.ascontiguousarray(image, dtype=np.float32)
+    if "paintlut:hash" not in attributes:
+        attributes = {**attributes, "paintlut:hash": content_hash(canonical_json(attributes), image)}
     with atomic_target(path) as tmp:
         _write_image(tmp, image, attributes)
     return path
 
 
 def write(path, table: np.ndarray, meta: dict) -> pathlib.Path:
-    """Write a LUT table (tiles, N_φd, N_θd, N_u, 3) and its meta atomically."""
+    """Write a LUT table (tiles, N_φd, N_θd, N_u, 3) and its meta atomically.
+    A table with values that are not finite (a paint beyond float32's range,
+    e.g. a facet lobe far narrower than the table) is refused: ValueError."""
     image = _to_image(table)
+    if not np.all(np.isfinite(image)):
+        raise ValueError(
+            "the baked LUT has values that are not finite (beyond float32's range): the paint's parameters are "
+            "outside what a LUT can hold (for example a slope far below 0.001; use 0 for a smooth surface)"
+        )
     meta_json = canonical_json(meta)
     return write_exr(
         path,
@@ -185,13 +311,17 @@ def _load(path):
     version = attrs["paintlut:format"]
     if version is None:
         raise LUTError(f"{path}: not a Paint LUT (no paintlut:format attribute)")
-    if int(version) != FORMAT_VERSION:
+    if not isinstance(version, int) or isinstance(version, bool):
+        raise LUTError(f"{path}: its paintlut:format is not a whole number (altered file)")
+    if version != FORMAT_VERSION:
         raise LUTError(f"{path}: LUT format version {version}; this version of Paint LUT reads {FORMAT_VERSION}")
     meta_json = attrs["paintlut:meta"]
     try:
         meta = json.loads(meta_json)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, RecursionError):
         raise LUTError(f"{path}: its paintlut:meta is not JSON (altered file)") from None
+    if not isinstance(meta, dict) or not all(isinstance(attrs[k], str) for k in ("paintlut:key", "paintlut:hash")):
+        raise LUTError(f"{path}: its paintlut:meta, key or hash is malformed (altered file)")
     header = {
         "meta": meta,
         "meta_json": meta_json,
@@ -203,9 +333,15 @@ def _load(path):
 
 
 def read_exr(path) -> np.ndarray:
-    """The float pixels (height, width, channels) of any EXR image, finite
-    values required (closure weights files); raises LUTError."""
-    pixels, _ = _read_image(path)
+    """The float pixels (height, width, channels) of an EXR image written by
+    ``write_exr`` (closure weights files), verified against its
+    ``paintlut:hash`` and finite; raises LUTError."""
+    pixels, attrs = _read_image(path, ("paintlut:hash",), prefix="paintlut:")
+    stored = attrs.pop("paintlut:hash")
+    if not isinstance(stored, str):
+        raise LUTError(f"{path}: no paintlut:hash (written by an older version, or altered): bake it again")
+    if stored != content_hash(canonical_json(attrs), pixels):
+        raise LUTError(f"{path}: content does not match its hash (altered or damaged file)")
     if not np.all(np.isfinite(pixels)):
         raise LUTError(f"{path}: pixel values are not finite")
     return pixels
@@ -226,8 +362,17 @@ def read(path):
         raise LUTError(f"{path}: header key does not match its meta (altered file)")
     if header["hash"] != content_hash(header["meta_json"], pixels):
         raise LUTError(f"{path}: content does not match its hash (altered or damaged file)")
-    n_u, n_d, n_p = meta["resolution"]
+    resolution = meta.get("resolution")
+    if (
+        not isinstance(resolution, list)
+        or len(resolution) != 3
+        or not all(isinstance(r, int) and not isinstance(r, bool) and r >= 2 for r in resolution)
+    ):
+        raise LUTError(f"{path}: its meta has no valid resolution (altered file)")
     tiles = meta.get("tiles", 1)
+    if not isinstance(tiles, int) or isinstance(tiles, bool) or tiles not in (1, 3):
+        raise LUTError(f"{path}: its meta has no valid tile count (altered file)")
+    n_u, n_d, n_p = resolution
     if pixels.shape != (tiles * n_p * n_d, n_u, 3):
-        raise LUTError(f"{path}: image size {pixels.shape} does not match resolution {meta['resolution']}")
+        raise LUTError(f"{path}: image size {pixels.shape} does not match resolution {resolution}")
     return pixels.reshape(tiles, n_p, n_d, n_u, 3), header

@@ -279,7 +279,7 @@ class Paint:
         if not isinstance(data, dict):
             raise ValueError("a paint description must be a table/object of fields")
         fields = {f.name for f in dataclasses.fields(cls)}
-        unknown = set(data) - fields
+        unknown = set(map(str, data)) - fields
         if unknown:
             raise ValueError(
                 f"unknown paint field(s) {', '.join(sorted(unknown))}; fields are {', '.join(sorted(fields))}"
@@ -287,7 +287,12 @@ class Paint:
         kw = dict(data)
         if isinstance(kw.get("n"), list):
             kw["n"] = tuple(kw["n"])
-        return cls(**kw)
+        if "name" in kw and not isinstance(kw["name"], str):
+            raise ValueError(f"name must be text, got {kw['name']!r}")
+        try:
+            return cls(**kw)
+        except TypeError as exc:  # a value of a kind no field takes (null, a table...)
+            raise ValueError(f"invalid paint description: {exc}") from None
 
     def index_at(self, wavelength_nm):
         """n at a wavelength [nm]."""
@@ -398,11 +403,24 @@ class Paint:
 
 
 def _colour_from_json(value, name):
-    if isinstance(value, dict):
-        scale = value.get("scale", 1.0)
-        if "wavelengths" in value and "values" in value:
-            return cm.Spectrum(value["wavelengths"], value["values"], name=value.get("spectrum"), scale=scale)
-        if "spectrum" in value:
-            return cm.Spectrum(value["spectrum"], scale=scale)
-        raise ValueError(f"{name}: a spectrum needs 'wavelengths' and 'values', or 'spectrum' naming a dataset or .csv")
-    return cm.Spectrum(value)
+    """A Spectrum from its JSON/TOML form; errors name the parameter."""
+    try:
+        if isinstance(value, dict):
+            unknown = set(value) - {"spectrum", "wavelengths", "values", "scale"}
+            if unknown:
+                raise ValueError(
+                    f"unknown spectrum field(s) {', '.join(sorted(map(str, unknown)))}; "
+                    "fields are spectrum, wavelengths, values, scale"
+                )
+            scale = value.get("scale", 1.0)
+            if "wavelengths" in value and "values" in value:
+                label = value.get("spectrum")
+                if label is not None and not isinstance(label, str):
+                    raise ValueError(f"'spectrum' (the name) must be text, got {label!r}")
+                return cm.Spectrum(value["wavelengths"], value["values"], name=label, scale=scale)
+            if isinstance(value.get("spectrum"), str):
+                return cm.Spectrum(value["spectrum"], scale=scale)
+            raise ValueError("a spectrum needs 'wavelengths' and 'values', or 'spectrum' naming a dataset or .csv")
+        return cm.Spectrum(value)
+    except ValueError as exc:
+        raise ValueError(f"{name}: {exc}") from None

@@ -7,13 +7,15 @@
 Per file: open it, bake the paint materials its objects use, skip unused and
 up-to-date ones (the LUT cache), save it atomically (addon.batch).  Writes a
 JSON report (--report) and prints a summary; exits 1 if any file or material
-failed, 2 on bad arguments."""
+failed (or a linked material's library holds no current bake), 2 on bad
+arguments (an unwritable --report is found before any work)."""
 
 from __future__ import annotations
 
 import argparse
 import concurrent.futures
 import json
+import os
 import pathlib
 import subprocess
 import sys
@@ -35,7 +37,23 @@ def parse(argv):
     args = parser.parse_args(argv)
     if args.jobs < 1:
         parser.error(f"--jobs must be an integer >= 1, got {args.jobs}")
+    if args.report:
+        problem = report_problem(pathlib.Path(args.report))
+        if problem:
+            parser.error(f"--report {args.report}: {problem}")
     return args
+
+
+def report_problem(path: pathlib.Path):
+    """Why the report cannot be written there (checked before any work), or None."""
+    if path.is_dir():
+        return "is a directory"
+    parent = path.parent if str(path.parent) else pathlib.Path(".")
+    if not parent.is_dir():
+        return f"no such directory {parent}"
+    if not os.access(parent, os.W_OK | os.X_OK):
+        return f"directory {parent} is not writable"
+    return None
 
 
 def script_argv():
@@ -82,8 +100,13 @@ def _child_prefix():
 
 def bake_parallel(args):
     """One process per file, at most ``--jobs`` at a time (Blender's data is
-    one file per process)."""
-    tmp = pathlib.Path(tempfile.mkdtemp(prefix="batch_bake"))
+    one file per process); their reports go to a temporary directory that
+    is removed afterwards."""
+    with tempfile.TemporaryDirectory(prefix="batch_bake") as tmp:
+        return _bake_in_children(args, pathlib.Path(tmp))
+
+
+def _bake_in_children(args, tmp):
     prefix = _child_prefix()
     flags = [*(["--force"] if args.force else []), *(["--pack"] if args.pack else [])]
 
@@ -103,14 +126,22 @@ def bake_parallel(args):
 
 def main(argv=None) -> int:
     args = parse(script_argv() if argv is None else argv)
-    entries = bake_parallel(args) if args.jobs > 1 and len(args.files) > 1 else bake_here(args)
-    if args.report:
-        from lut import lutfile
-
-        lutfile.atomic_write_bytes(args.report, (json.dumps(entries, indent=2) + "\n").encode())
+    try:
+        entries = bake_parallel(args) if args.jobs > 1 and len(args.files) > 1 else bake_here(args)
+    except KeyboardInterrupt:
+        print("interrupted: files already saved keep their bakes", file=sys.stderr)
+        return 130
     from addon import batch
 
     print(batch.summary(entries))
+    if args.report:
+        from lut import lutfile
+
+        try:
+            lutfile.atomic_write_bytes(args.report, (json.dumps(entries, indent=2) + "\n").encode())
+        except OSError as exc:
+            print(f"error: cannot write the report {args.report}: {exc}", file=sys.stderr)
+            return 2
     return 1 if batch.failed(entries) else 0
 
 

@@ -1,0 +1,131 @@
+"""Damaged LUT and weights files, with a fixed seed: every bit flip and every
+truncation either loads exactly the data that was written or raises
+lut.LUTError; never another exception.  Both readers: OpenImageIO (when
+installed) and the numpy fallback (lut.exr)."""
+
+import random
+
+import numpy as np
+import pytest
+
+import lut
+from lut import lutfile
+
+SEED = 20240611
+FLIPS = 160
+RESOLUTION = (8, 6, 4)
+
+
+def _readers():
+    readers = ["fallback"]
+    if lutfile._oiio() is not None:
+        readers.insert(0, "openimageio")
+    return readers
+
+
+@pytest.fixture(params=_readers())
+def reader(request, monkeypatch):
+    if request.param == "fallback":
+        monkeypatch.setattr(lutfile, "_oiio", lambda: None)
+    return request.param
+
+
+@pytest.fixture(scope="module")
+def lut_bytes(tmp_path_factory):
+    """A small LUT written both compressed (OpenImageIO) and not (lut.exr)."""
+    directory = tmp_path_factory.mktemp("fuzz")
+    path = lut.bake(lut.Paint(rho=(0.6, 0.3, 0.2), single=0.1, g=0.3), directory, resolution=RESOLUTION)
+    table, header = lutfile.read(path)
+    files = {"openimageio" if lutfile._oiio() is not None else "fallback": path.read_bytes()}
+    plain = directory / "plain.exr"
+    lutfile.exr.write(
+        plain,
+        lutfile._to_image(table),
+        attributes={
+            "paintlut:format": lutfile.FORMAT_VERSION,
+            "paintlut:meta": header["meta_json"],
+            "paintlut:key": header["key"],
+            "paintlut:hash": header["hash"],
+        },
+    )
+    files["fallback"] = plain.read_bytes()
+    return files, table, header["meta"]
+
+
+@pytest.fixture(scope="module")
+def weights_bytes(tmp_path_factory):
+    directory = tmp_path_factory.mktemp("fuzz_weights")
+    pixels = np.random.default_rng(SEED).uniform(0.0, 2.0, (5, 17, 3)).astype(np.float32)
+    attrs = {"paintlut:closures": "('lambert', 'toon 0.2', 'metallic 0.1')"}
+    path = lutfile.write_exr(directory / "weights.exr", pixels, attrs)
+    return path.read_bytes(), pixels
+
+
+def _damaged(data: bytes, rng: random.Random):
+    """Single-bit flips (half of them in the header, where the metadata
+    lives) and truncations at random lengths."""
+    header_end = min(len(data), data.find(b"\0\0") + 2 if b"\0\0" in data else len(data), 2048)
+    for i in range(FLIPS):
+        damaged = bytearray(data)
+        pos = rng.randrange(max(header_end, 8)) if i % 2 else rng.randrange(len(data))
+        damaged[pos] ^= 1 << rng.randrange(8)
+        yield f"bit flip at byte {pos}", bytes(damaged)
+    for cut in sorted(rng.sample(range(len(data)), 40)):
+        yield f"truncated to {cut} bytes", data[:cut]
+
+
+def test_damaged_luts_load_identical_data_or_raise_lut_error(reader, lut_bytes, tmp_path):
+    files, table, meta = lut_bytes
+    target = tmp_path / "paintlut-damaged.exr"
+    rng = random.Random(SEED)
+    for written_by, data in files.items():
+        refused = 0
+        for what, damaged in _damaged(data, rng):
+            what = f"{written_by} file, {what}"
+            target.write_bytes(damaged)
+            try:
+                loaded = lut.load_lut(target)
+            except lut.LUTError as exc:
+                assert str(target) in str(exc), what
+                refused += 1
+                continue
+            except Exception as exc:  # the defect this test exists for
+                pytest.fail(f"{what}: {type(exc).__name__}: {exc}")
+            assert np.array_equal(loaded.data, table) and loaded.meta == meta, what
+        assert refused > FLIPS // 2  # most damage is detected, not ignored
+
+
+def test_damaged_weights_load_identical_data_or_raise_lut_error(reader, weights_bytes, tmp_path):
+    data, pixels = weights_bytes  # ZIP-compressed when OpenImageIO wrote it: the fallback reads that too
+    target = tmp_path / "paintfit-damaged.exr"
+    rng = random.Random(SEED + 1)
+    for what, damaged in _damaged(data, rng):
+        target.write_bytes(damaged)
+        try:
+            loaded = lutfile.read_exr(target)
+        except lut.LUTError as exc:
+            assert str(target) in str(exc), what
+            continue
+        except Exception as exc:
+            pytest.fail(f"{what}: {type(exc).__name__}: {exc}")
+        assert np.array_equal(loaded, pixels), what
+
+
+def test_a_weights_file_without_its_hash_is_refused(tmp_path, reader):
+    path = tmp_path / "old.exr"
+    lutfile.exr.write(path, np.ones((2, 3, 3), np.float32), attributes={"paintlut:closures": "('lambert',)"})
+    with pytest.raises(lut.LUTError, match="no paintlut:hash"):
+        lutfile.read_exr(path)
+
+
+def test_bake_rebakes_a_lut_whose_metadata_is_not_utf8(reader, tmp_path):
+    paint = lut.Paint(rho=0.4)
+    path = lut.bake(paint, tmp_path, resolution=RESOLUTION)
+    data = bytearray(path.read_bytes())
+    at = data.index(b'"paint":{')
+    data[at + 3] = 0xFF  # one damaged byte inside the paintlut:meta text
+    path.write_bytes(bytes(data))
+    with pytest.raises(lut.LUTError, match=str(path.name)):
+        lut.load_lut(path)
+    assert lut.bake(paint, tmp_path, resolution=RESOLUTION) == path
+    assert lut.load_lut(path).paint == paint  # baked again, whole
