@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import bpy
 
-from lut import closures, fitting
+from lut import closures, fitting, lutfile
 
 GROUP_PREFIX = "Paint LUT"
 INPUTS = ("Pigment Color", "Single Scattering Color", "Surface Reflection")
@@ -85,11 +85,10 @@ def group_name(fit: fitting.Fit) -> str:
 
 
 def _fit_id(fit: fitting.Fit, weights_path) -> str:
-    return f"{fit.lut_key}:{fit.target}:{int(fit.exact_metallic)}:{pathlib_name(weights_path)}"
-
-
-def pathlib_name(path) -> str:
-    return bpy.path.basename(str(path))
+    """What identifies a group's content: its LUT, and the fit (header and
+    weights file)."""
+    content = lutfile.cache_key({"fit": fit.header(), "file": bpy.path.basename(str(weights_path))})
+    return f"{fit.lut_key}:{fit.target}:{int(fit.exact_metallic)}:{content[:16]}"
 
 
 class _Layout:

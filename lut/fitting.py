@@ -73,6 +73,8 @@ BUDGET = {"CYCLES": 8, "EEVEE": 3}
 #: Views (columns of the weights texture) and the light grid of each view.
 VIEWS = 24
 LIGHT_GRID = (24, 24)
+#: sin θl below which a row's measure dθl dφ = dω/sin θl is not raised further.
+MIN_SIN = np.sin(np.radians(5.0))
 #: Lights beyond this polar angle are not fitted (their cos θl weight is nil).
 MAX_LIGHT = np.radians(88.0)
 #: Views are evaluated at most this far from the normal (θv = 90° exactly is
@@ -214,7 +216,10 @@ def light_rows(theta_v, grid=LIGHT_GRID, max_light=MAX_LIGHT):
     # The model puts the light at azimuth π: rotate the viewer (azimuth 0) with it.
     phi = np.pi - np.arctan2(np.where(ok, ly, 0.0), np.where(ok, lx, -1.0))
     phi = np.mod(phi + np.pi, 2 * np.pi) - np.pi
-    weight = np.where(ok, np.sqrt(d_omega) * np.cos(theta_l), 0.0)
+    # The acceptance measure samples θl and φ uniformly, not solid angle:
+    # dθl dφ = dω / sin θl (bounded near the normal, where rows are few).
+    d_measure = d_omega / np.maximum(np.sin(theta_l), MIN_SIN)
+    weight = np.where(ok, np.sqrt(d_measure) * np.cos(theta_l), 0.0)
     return theta_l, phi, weight
 
 

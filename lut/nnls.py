@@ -71,19 +71,25 @@ def nnls_gram_batch(gram, rhs, upper=None, max_iter=None):
     problem stepping together with its own passive set (a masked system:
     variables outside the set get an identity row and a zero right-hand
     side), so the cost is a few batched solves rather than B Python loops.
-    ``upper`` (n,): as in ``nnls_gram``, variables above it are fixed at it
-    and the rest solved again, once."""
+    ``upper`` (n,): variables above it are fixed at it and the rest solved
+    again, until none is above (the bound-constrained optimum when the
+    bound binds on few variables, as for Mix Shader factors)."""
     gram, rhs = np.asarray(gram, dtype=float), np.asarray(rhs, dtype=float)
     b, n = rhs.shape
-    x = _batch_active_set(gram, rhs, np.zeros((b, n), dtype=bool), max_iter)
-    if upper is not None:
-        upper = np.broadcast_to(np.asarray(upper, dtype=float), (n,))
-        over = x > upper
-        if over.any():
-            fixed_x = np.where(over, upper, 0.0)
-            rhs2 = rhs - np.einsum("bij,bj->bi", gram, fixed_x)
-            x2 = _batch_active_set(gram, rhs2, over, max_iter)
-            x = np.where(over, upper, x2)
+    fixed = np.zeros((b, n), dtype=bool)
+    x = _batch_active_set(gram, rhs, fixed, max_iter)
+    if upper is None:
+        return x
+    upper = np.broadcast_to(np.asarray(upper, dtype=float), (n,))
+    for _ in range(n):
+        over = (x > upper) & ~fixed
+        if not over.any():
+            break
+        fixed |= over
+        fixed_x = np.where(fixed, upper, 0.0)
+        x = np.where(
+            fixed, upper, _batch_active_set(gram, rhs - np.einsum("bij,bj->bi", gram, fixed_x), fixed, max_iter)
+        )
     return x
 
 

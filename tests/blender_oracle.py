@@ -100,12 +100,9 @@ class Oracle:
         self.plane.data.materials.append(mat)
         return mat
 
-    def radiance(self, theta_l, theta_v, phi):
-        """RGB radiance toward a viewer at polar angle θv and azimuth φ from
-        the light's plane (φ = 0: the viewer on the far side, the mirror
-        direction when θv = θl); equals f·E·cos θl."""
-        # Light travels towards -ω_l with ω_l = (-sin θl, 0, cos θl), i.e. the
-        # model's source at azimuth π; the sun points along -Z rotated about Y.
+    def image(self, theta_l, theta_v, phi):
+        """The whole rendered image (RESOLUTION², RGB) for one geometry: every
+        pixel of the plane sees the same directions."""
         self.sun.rotation_euler = (0.0, -theta_l, 0.0)
         view = Vector((math.sin(theta_v) * math.cos(phi), math.sin(theta_v) * math.sin(phi), math.cos(theta_v)))
         self.camera.location = 5.0 * view
@@ -120,7 +117,15 @@ class Oracle:
             pixels = exr.read(self._path)[0]
         else:
             pixels = oiio.ImageBuf(self._path).get_pixels(oiio.FLOAT)
-        return np.asarray(pixels[RESOLUTION // 2, RESOLUTION // 2, :3], dtype=float)
+        return np.asarray(pixels[..., :3], dtype=float)
+
+    def radiance(self, theta_l, theta_v, phi):
+        """RGB radiance toward a viewer at polar angle θv and azimuth φ from
+        the light's plane (φ = 0: the viewer on the far side, the mirror
+        direction when θv = θl); equals f·E·cos θl."""
+        # Light travels towards -ω_l with ω_l = (-sin θl, 0, cos θl), i.e. the
+        # model's source at azimuth π; the sun points along -Z rotated about Y.
+        return self.image(theta_l, theta_v, phi)[RESOLUTION // 2, RESOLUTION // 2]
 
     def brdf(self, theta_l, theta_v, phi):
         """The rendered BRDF: radiance / (E cos θl)."""
@@ -142,6 +147,17 @@ def relative_rms(oracle, paint, grid=GRID, best_scale=False) -> float:
     got, ref, weight = np.array(got), np.array(ref), np.array(weight)[:, None]
     scale = np.sum(got * ref * weight**2) / np.sum((got * weight) ** 2) if best_scale else 1.0
     return float(np.sqrt(np.sum(((scale * got - ref) * weight) ** 2) / np.sum((ref * weight) ** 2)))
+
+
+def paint_material(oracle, paint, directory, name="paint", **options):
+    """A material on the plane rendering ``paint`` through the add-on (set
+    and baked in ``directory``); returns (material, lut.render.RenderBake)."""
+    from addon import api
+
+    material = oracle.material(name)
+    api.set_paint(material, paint)
+    result = api.bake_material(material, directory=directory, **options)
+    return material, result
 
 
 def principled(oracle, paint):

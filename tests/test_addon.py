@@ -1,47 +1,56 @@
-"""The Blender add-on on the pip bpy module (5.0.1): registration, the
-material settings, presets, stale tracking and baking."""
+"""The Blender add-on on the pip bpy module: registration, the material
+settings, presets, live colours, stale tracking, baking paint types and the
+node groups."""
+
+import json
 
 import numpy as np
 import pytest
 
 bpy = pytest.importorskip("bpy")
 
-import addon  # noqa: E402
 import lut  # noqa: E402
-from addon import api, jobs  # noqa: E402
+from lut import fitting, render  # noqa: E402
 
-
-@pytest.fixture(scope="module", autouse=True)
-def registered():
-    addon.register()
-    yield
-    addon.unregister()
+SMALL = {"resolution": (8, 6, 4)}
 
 
 @pytest.fixture
-def material():
-    bpy.ops.wm.read_factory_settings(use_empty=True)
+def material(fresh_file):
     return bpy.data.materials.new("paint")
 
 
-def test_register_and_unregister_cleanly():
-    addon.unregister()
+def _group_node(material, target="CYCLES"):
+    from addon import nodes
+
+    return nodes.group_of(material, target)
+
+
+def _inputs(material, target="CYCLES"):
+    node = _group_node(material, target)
+    return {s.name: (tuple(s.default_value)[:3] if s.type == "RGBA" else s.default_value) for s in node.inputs}
+
+
+def test_register_and_unregister_cleanly(addon_registered):
+    addon_registered.unregister()
     assert not hasattr(bpy.types.Material, "paint_lut")
     assert not hasattr(bpy.types, "PAINTLUT_OT_bake")
-    addon.register()
+    addon_registered.register()
     assert hasattr(bpy.types.Material, "paint_lut")
     assert hasattr(bpy.ops.paint_lut, "bake")
     assert hasattr(bpy.types, "MATERIAL_PT_paint_lut") and hasattr(bpy.types, "NODE_PT_paint_lut")
 
 
 def test_defaults_are_the_paint_defaults(material):
+    from addon import api
+
     settings = material.paint_lut
     assert settings.preset == "CUSTOM" and settings.stale
     assert api.paint_of(material) == lut.Paint()
 
 
-def test_limits_follow_the_paint_limits():
-    props = addon.properties.PaintLUTSettings.bl_rna.properties
+def test_limits_follow_the_paint_limits(addon_registered):
+    props = addon_registered.properties.PaintLUTSettings.bl_rna.properties
     assert props["n"].hard_min == 1.0
     assert props["g"].hard_min > -1.0 and props["g"].hard_max < 1.0
     assert props["slope"].hard_min == 0.0 and props["slope"].hard_max == 3.0
@@ -49,116 +58,225 @@ def test_limits_follow_the_paint_limits():
     assert props["facet"].hard_min == 0.0
 
 
-def test_preset_fills_the_fields_and_bakes_the_spectral_paint(material):
+def test_preset_fills_the_fields_with_the_rgb_that_renders_it_exactly(material):
+    """A spectral preset's fields are the RGB pigment whose diffuse
+    amplitude k(ρ) is the spectrally integrated one (so the colour inputs
+    render the spectral paint exactly); bakes use the exact spectral paint."""
+    from addon import api
+
     settings = material.paint_lut
     settings.stale = False
     settings.preset = "green_carc"
     carc = lut.preset("green_carc")
     assert settings.slope == pytest.approx(2.0) and settings.distribution == "EXPONENTIAL"
     assert settings.g == pytest.approx(0.3)
-    np.testing.assert_allclose(tuple(settings.rho), np.clip(carc.rho.rgb(), 0, 1), rtol=1e-6)
-    assert settings.stale
+    rbar = carc.internal_reflectance()
+    expected = lut.paint.pigment_of_amplitude(carc.amplitudes()[:, 2], rbar)
+    np.testing.assert_allclose(tuple(settings.rho), expected, rtol=1e-6)
+    assert not np.allclose(expected, carc.rho.rgb(), rtol=0.01)  # not the spectrum's RGB: ρ is not linear
+    assert settings.stale  # another paint type
     assert api.paint_of(material) == carc  # the exact spectral paint, not its RGB
 
 
-def test_editing_a_field_makes_the_paint_custom_and_stale(material):
+def test_type_fields_make_the_bake_stale_colours_do_not(material, lut_dir):
+    from addon import api
+
     settings = material.paint_lut
     settings.preset = "glossy_white"
-    settings.stale = False
+    api.bake_material(material, directory=lut_dir, **SMALL)
+    assert not settings.stale
+    settings.rho = (0.7, 0.2, 0.1)
+    settings.single = (0.1, 0.0, 0.3)
+    settings.facet = 0.6
+    assert settings.preset == "CUSTOM" and not settings.stale  # colours are node inputs: no bake
+    for target in ("CYCLES", "EEVEE"):  # and they reached both engines' groups at once
+        values = _inputs(material, target)
+        assert values["Pigment Color"] == pytest.approx((0.7, 0.2, 0.1))
+        assert values["Single Scattering Color"] == pytest.approx((0.1, 0.0, 0.3))
+        assert values["Surface Reflection"] == pytest.approx(0.6)
     settings.g = 0.5
-    assert settings.preset == "CUSTOM" and settings.stale
+    assert settings.stale
     paint = api.paint_of(material)
     assert paint.g == 0.5 and paint.rho == pytest.approx(tuple(settings.rho))
 
 
-def test_bake_records_the_lut_and_clears_stale(material, tmp_path, monkeypatch):
-    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
+def test_every_colour_of_a_type_shares_one_bake_and_one_group(fresh_file, lut_dir):
+    """Two materials of one paint type: the second bake computes nothing and
+    both use the same node groups, each with its own colour inputs."""
+    from addon import api
+
+    a = api.new_material("car", lut.Paint(rho=(0.8, 0.1, 0.1), slope=0.2), directory=lut_dir, **SMALL)
+    before = sorted(lut_dir.iterdir())
+    b = bpy.data.materials.new("car Eevee")  # a name that once collided with the first's EEVEE group
+    api.set_paint(b, lut.Paint(rho=(0.1, 0.1, 0.8), single=0.2, slope=0.2))
+    result = api.bake_material(b, directory=lut_dir, **SMALL)
+    assert result.computed == [] and sorted(lut_dir.iterdir()) == before
+    for target in ("CYCLES", "EEVEE"):
+        assert _group_node(a, target).node_tree == _group_node(b, target).node_tree
+    assert _inputs(a)["Pigment Color"] == pytest.approx((0.8, 0.1, 0.1))
+    assert _inputs(b)["Pigment Color"] == pytest.approx((0.1, 0.1, 0.8))
+    status = api.bake_materials({a, b}, directory=lut_dir, **SMALL)
+    assert status == {"car": "cached", "car Eevee": "cached"}
+    assert status["car"].key == status["car Eevee"].key
+
+
+def test_bake_records_the_lut_the_fits_and_their_errors(material, lut_dir):
+    from addon import api
+
     material.paint_lut.rho = (0.7, 0.2, 0.1)
-    path = api.bake_material(material, resolution=(8, 6, 4))
-    assert path.exists() and material.paint_lut.lut_path == str(path) and not material.paint_lut.stale
-    assert lut.load_lut(path).paint == api.paint_of(material)
-    material.paint_lut.slope = 0.2
-    assert material.paint_lut.stale
+    result = api.bake_material(material, directory=lut_dir, **SMALL)
+    assert result.lut_path.exists() and material.paint_lut.lut_path == str(result.lut_path)
+    assert not material.paint_lut.stale
+    assert lut.load_lut(result.lut_path).matches(api.paint_of(material))
+    errors = api.fit_errors(material)
+    assert set(errors) == {"CYCLES", "EEVEE"}
+    paint = api.paint_of(material)
+    for target, (error, goal) in errors.items():
+        assert error == pytest.approx(result.fits[target].error(result.lut.amplitudes(paint)), rel=1e-6)
+        assert goal == fitting.TARGET_ERROR[target]["smooth"]
+    material.paint_lut.single = (0.3, 0.3, 0.3)  # the error follows the colours' mix at once
+    assert api.fit_errors(material)["CYCLES"][0] != pytest.approx(errors["CYCLES"][0], rel=1e-3)
 
 
-def test_bake_operator_runs_headless(material, tmp_path, monkeypatch):
-    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
+def test_glossy_black_bakes_and_renders_only_its_mirror(material, lut_dir):
+    """ρ = 0, no single scattering, smooth: the type still has its (unused)
+    components, so the bake and the groups work; the colours are zero."""
+    from addon import api
+
+    api.set_paint(material, lut.Paint(rho=0.0))
+    api.bake_material(material, directory=lut_dir, **SMALL)
+    assert _inputs(material)["Pigment Color"] == pytest.approx((0.0, 0.0, 0.0))
+    group = _group_node(material).node_tree
+    assert any(nd.type == "BSDF_METALLIC" and nd.label.startswith("Mirror") for nd in group.nodes)
+
+
+def test_bake_operator_runs_headless(material, lut_dir, monkeypatch):
+    from addon import api
+
+    monkeypatch.setattr(api, "lut_directory", lambda: lut_dir)  # the operator bakes where the file says
     material.paint_lut.preset = "glossy_white"
     with bpy.context.temp_override(material=material):
         assert bpy.ops.paint_lut.bake("EXEC_DEFAULT") == {"FINISHED"}
     assert not material.paint_lut.stale and material.paint_lut.lut_path.endswith(".exr")
 
 
-def test_background_job_reports_progress_and_can_be_cancelled(tmp_path):
-    job = jobs.BakeJob(lut.Paint(rho=0.5, single=0.3, slope=0.3), tmp_path, resolution=(8, 6, 4)).start()
-    assert job.wait(60) and job.error is None and job.progress == 1.0 and job.path.exists()
-    slow = jobs.BakeJob(lut.Paint(rho=0.4, single=0.3, slope=0.5), tmp_path, resolution=(96, 48, 24))
+def test_background_job_reports_progress_and_cancels_anywhere(tmp_path):
+    """Progress runs over the LUT and every fit; a cancel in the fits (after
+    the LUT) stops before any weights file is written."""
+    from addon import jobs
+
+    job = jobs.BakeJob(lut.Paint(rho=0.5, single=0.3, slope=0.3), tmp_path, **SMALL).start()
+    assert job.wait(120) and job.error is None and job.progress == 1.0 and job.result.lut_path.exists()
+    assert set(job.result.fits) == {"CYCLES", "EEVEE"}
+    late = jobs.BakeJob(lut.Paint(rho=0.4, single=0.3, slope=0.5), tmp_path / "late", **SMALL)
+    seen = []
+
+    def progress(fraction, original=late._progress):
+        seen.append(fraction)
+        if fraction >= render.LUT_SHARE:
+            late.cancel()
+        original(fraction)
+
+    late._progress = progress
+    late.start()
+    assert late.wait(120) and late.error == "cancelled" and late.result is None
+    assert max(seen) >= render.LUT_SHARE
+    assert not list((tmp_path / "late").glob("paintfit-*"))  # no fit written after the cancel
+    slow = jobs.BakeJob(lut.Paint(rho=0.4, single=0.3, slope=0.5), tmp_path / "slow", resolution=(96, 48, 24))
     slow.cancel()
     slow.start()
-    assert slow.wait(60) and slow.error == "cancelled" and slow.path is None
-    # Nothing half-written: only the first job's LUT and its two weights files.
-    expected = [job.path, *(weights for _, weights in job.fits.values())]
-    assert sorted(tmp_path.iterdir()) == sorted(expected)
-    assert set(job.fits) == {"CYCLES", "EEVEE"}
+    assert slow.wait(60) and slow.error == "cancelled"
+    assert not (tmp_path / "slow").exists() or not list((tmp_path / "slow").iterdir())  # nothing half-written
 
 
-def test_bake_wires_a_node_group(material, tmp_path, monkeypatch):
-    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
+def test_bake_wires_a_group_per_engine_with_colour_inputs(material, lut_dir):
+    from addon import api, nodes
+
     material.paint_lut.preset = "glossy_white"
-    api.bake_material(material, resolution=(8, 6, 4))
+    api.bake_material(material, directory=lut_dir, **SMALL)
     tree = material.node_tree
-    for target, suffix in (("CYCLES", ""), ("EEVEE", " Eevee")):
-        # One output per engine, each fed by that engine's group.
+    for target in ("CYCLES", "EEVEE"):
         output = tree.get_output_node(target)
         assert output.target == target
         source = output.inputs["Surface"].links[0].from_node
-        assert source.type == "GROUP" and source.node_tree.name == f"Paint LUT {material.name}{suffix}"
+        assert source.type == "GROUP" and source.node_tree.name.startswith("Paint LUT n1.5 smooth")
+        assert [s.name for s in source.inputs] == list(nodes.INPUTS)
         image = next(nd.image for nd in source.node_tree.nodes if nd.type == "TEX_IMAGE")
         assert image.colorspace_settings.name == "Non-Color"
-    # EEVEE renders Toon closures as Lambert: its group has none.
-    eevee = addon.nodes.group_of(material, "EEVEE").node_tree
-    assert not any(nd.type == "BSDF_TOON" for nd in eevee.nodes)
-    assert any(nd.type == "BSDF_TOON" for nd in addon.nodes.group_of(material).node_tree.nodes)
-    names = sorted(p.name.rsplit("-", 1)[0] for p in tmp_path.iterdir())
-    assert names == ["paintfit", "paintfit-eevee", "paintlut"]
-    # Rebaking rewires in place: still two outputs and two group nodes.
-    material.paint_lut.stale = True
-    api.bake_material(material, resolution=(8, 6, 4))
+    eevee = _group_node(material, "EEVEE").node_tree
+    assert not any(nd.type == "BSDF_TOON" for nd in eevee.nodes)  # EEVEE draws Toon closures as Lambert
+    assert any(nd.type == "BSDF_TOON" for nd in _group_node(material).node_tree.nodes)
+    names = sorted(p.name.rsplit("-", 1)[0] for p in lut_dir.iterdir())
+    assert names == ["paintfit-cycles", "paintfit-eevee", "paintlut"]
+    # A texture driving the pigment survives a rebake; still two outputs and two group nodes.
+    texture = tree.nodes.new("ShaderNodeTexImage")
+    tree.links.new(texture.outputs["Color"], _group_node(material).inputs["Pigment Color"])
+    material.paint_lut.g = 0.3
+    api.bake_material(material, directory=lut_dir, **SMALL)
     assert sum(nd.type == "OUTPUT_MATERIAL" for nd in tree.nodes) == 2
     assert sum(nd.type == "GROUP" for nd in tree.nodes) == 2
+    assert _group_node(material).inputs["Pigment Color"].links[0].from_node == texture
     rough = bpy.data.materials.new("rough")
     rough.paint_lut.slope = 0.3
-    api.bake_material(rough, resolution=(8, 6, 4))
+    api.bake_material(rough, directory=lut_dir, **SMALL)
     assert not rough.paint_lut.stale
-    group = next(nd for nd in rough.node_tree.nodes if nd.type == "GROUP").node_tree
+    group = _group_node(rough).node_tree
     assert any(nd.type == "BSDF_METALLIC" for nd in group.nodes)  # the facet lobe
 
 
-def test_new_material_is_baked_and_wired(tmp_path, monkeypatch):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
+def test_groups_are_laid_out_in_labelled_columns_without_overlap(material, lut_dir):
+    """An artist who opens a group sees columns in frames (inputs, view
+    angle, pigment, weights, colours, closures, sum): no two nodes overlap."""
+    from addon import api, nodes
+
+    api.set_paint(material, lut.Paint(rho=0.3, single=0.2, g=-0.4, slope=0.6, distribution="exponential"))
+    api.bake_material(material, directory=lut_dir, **SMALL)
+    for target in ("CYCLES", "EEVEE"):
+        group = _group_node(material, target).node_tree
+        frames = {nd.label for nd in group.nodes if nd.type == "FRAME"}
+        assert {"Inputs", "View angle", "Weights per view", "Closures", "Sum of closures"} <= frames
+        assert group.description
+        boxes = []
+        for nd in group.nodes:
+            if nd.type in ("FRAME", "GROUP_OUTPUT"):
+                continue
+            x, y = nd.location
+            boxes.append((nd.name, x, x + nd.width, y - nodes.estimated_height(nd), y))
+        for i, (name, x0, x1, y0, y1) in enumerate(boxes):
+            for other, u0, u1, v0, v1 in boxes[i + 1 :]:
+                assert x1 <= u0 or u1 <= x0 or y1 <= v0 or v1 <= y0, (name, other)
+
+
+def test_new_material_is_baked_and_wired(fresh_file, lut_dir):
+    from addon import api
+
     paint = lut.Paint(rho=(0.6, 0.3, 0.2), single=0.1, g=0.2, slope=0.1)
-    material = api.new_material("satin red", paint, resolution=(8, 6, 4))
+    material = api.new_material("satin red", paint, directory=lut_dir, **SMALL)
     assert material.paint_lut.enabled and not material.paint_lut.stale
     assert api.paint_of(material) == paint
-    assert any(nd.type == "GROUP" for nd in material.node_tree.nodes)
-    carc = api.new_material("carc", lut.preset("green_carc"), resolution=(8, 6, 4))
+    assert _group_node(material) is not None
+    carc = api.new_material("carc", lut.preset("green_carc"), directory=lut_dir, **SMALL)
     assert carc.paint_lut.preset == "green_carc"
+    with pytest.raises(ValueError, match=r"n must be in \[1, 4\]"):
+        api.new_material("clamped", lut.Paint(n=5.0), directory=lut_dir, **SMALL)
+    assert "clamped" not in bpy.data.materials  # nothing left behind
 
 
-def test_spectral_paints_are_stored_whole(tmp_path, monkeypatch):
+def test_spectral_paints_are_stored_whole(fresh_file, tmp_path):
     """A spectral paint that is not a preset survives on the material (and a
-    save) exactly; the fields show its RGB; editing one makes it Custom RGB."""
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path / "luts")
+    save) exactly; the fields show the RGB that renders it; editing one makes
+    it Custom RGB."""
+    from addon import api
+
     paint = lut.Paint(n=(1.49, 0.0042), rho="ColorChecker N Ohta/blue", single=0.05)
-    material = api.new_material("blue", paint, resolution=(8, 6, 4))
+    material = api.new_material("blue", paint, directory=tmp_path / "luts", **SMALL)
     material.use_fake_user = True
     settings = material.paint_lut
     assert settings.preset == "SPECTRAL" and not settings.stale
     assert api.paint_of(material) == paint
     assert settings.n == pytest.approx(float(paint.index_at(589.3)))
-    assert tuple(settings.rho) == pytest.approx(tuple(paint.rho.rgb("Linear Rec.709")), abs=1e-6)
+    expected = render.node_inputs(paint)["Pigment Color"]
+    assert tuple(settings.rho) == pytest.approx(expected, abs=1e-6)
     blend = tmp_path / "blue.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend))
     bpy.ops.wm.open_mainfile(filepath=str(blend))
@@ -173,9 +291,9 @@ def test_spectral_paints_are_stored_whole(tmp_path, monkeypatch):
         api.paint_of(material)
 
 
-def test_bake_scene_reports_baked_cached_unused(tmp_path, monkeypatch):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
+def test_bake_scene_reports_baked_cached_unused(fresh_file, lut_dir):
+    from addon import api
+
     scene = bpy.context.scene
     materials = [bpy.data.materials.new(name) for name in ("a", "b", "unused")]
     for i, material in enumerate(materials):
@@ -185,21 +303,38 @@ def test_bake_scene_reports_baked_cached_unused(tmp_path, monkeypatch):
         mesh = bpy.data.meshes.new(material.name)
         mesh.materials.append(material)
         scene.collection.objects.link(bpy.data.objects.new(material.name, mesh))
-    small = {"resolution": (8, 6, 4)}
+    small = {"directory": lut_dir, **SMALL}
     assert api.bake_scene(scene, **small) == {"a": "baked", "b": "baked", "unused": "unused"}
     assert api.bake_scene(scene, **small) == {"a": "cached", "b": "cached", "unused": "unused"}
     materials[1].paint_lut.g = 0.4
-    assert api.bake_scene(scene, **small) == {"a": "cached", "b": "baked", "unused": "unused"}
+    status = api.bake_scene(scene, **small)
+    assert status == {"a": "cached", "b": "baked", "unused": "unused"}
+    assert status["a"].key != status["b"].key and set(status["b"].errors) == {"CYCLES", "EEVEE"}
     assert api.bake_scene(scene, force=True, **small)["a"] == "baked"
 
 
-def test_saved_files_reference_luts_relatively(tmp_path):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
+def test_a_material_from_an_older_release_is_rebaked_not_trusted(material, lut_dir):
+    """A group without colour inputs (the previous release's) is not
+    current: batch and bake_scene rebake it, and the material is rewired."""
+    from addon import api, nodes
+
+    api.bake_material(material, directory=lut_dir, **SMALL)
+    old = bpy.data.node_groups.new("Paint LUT paint", "ShaderNodeTree")
+    old.interface.new_socket(name="Shader", in_out="OUTPUT", socket_type="NodeSocketShader")
+    _group_node(material).node_tree = old
+    assert not api.is_current(material, api.paint_of(material), directory=lut_dir, **SMALL)
+    api.bake_materials({material}, directory=lut_dir, **SMALL)
+    assert nodes.is_paint_group(_group_node(material).node_tree)
+
+
+def test_saved_files_reference_luts_relatively(fresh_file, tmp_path):
+    from addon import api, operators
+
     bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "scene.blend"))
-    material = api.new_material("paint", lut.Paint(rho=0.5), resolution=(8, 6, 4))
+    material = api.new_material("paint", lut.Paint(rho=0.5), **SMALL)
     assert material.paint_lut.lut_path.startswith("//paint_lut/paintlut-")
-    group = next(nd for nd in material.node_tree.nodes if nd.type == "GROUP").node_tree
-    image = next(nd.image for nd in group.nodes if nd.type == "TEX_IMAGE")
+    image = next(nd.image for nd in _group_node(material).node_tree.nodes if nd.type == "TEX_IMAGE")
     assert image.filepath.startswith("//paint_lut/paintfit-")
     assert (tmp_path / "paint_lut").is_dir()
-    assert "UNDO" in addon.operators.PAINTLUT_OT_bake.bl_options
+    assert "UNDO" in operators.PAINTLUT_OT_bake.bl_options
+    assert json.loads(material.paint_lut.fits).keys() == {"CYCLES", "EEVEE"}
