@@ -30,7 +30,7 @@ import pathlib
 import bpy
 
 import lut
-from lut import closures, lutfile
+from lut import closures, fitting, lutfile
 
 from . import api, nodes
 
@@ -90,10 +90,13 @@ def linked_status(material) -> dict:
     if not settings.stale and settings.lut_path:
         path = pathlib.Path(bpy.path.abspath(settings.lut_path, library=material.library))
         try:
-            lut.load_lut(path)
+            table = lut.load_lut(path)
             for target in closures.TARGETS:
-                lutfile.read_exr(closures.weights_path(path, target))
-            baked = all(nodes.group_of(material, target) is not None for target in closures.TARGETS)
+                fitted = fitting.read_fit(fitting.fit_path(path, target, nodes.EXACT_METALLIC))
+                baked_node = nodes.group_of(material, target)
+                if fitted.lut_key != table.key or baked_node is None or not nodes.is_paint_group(baked_node.node_tree):
+                    raise lut.LUTError("not wired to this bake")
+            baked = True
         except lut.LUTError:
             baked = False
     reason = f"linked from {library}: bake it there (batch_bake.py {library})"

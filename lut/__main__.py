@@ -20,7 +20,7 @@ import sys
 import time
 import tomllib
 
-from . import __version__, baking, cleanup, colour_management, examples, figures, lutfile, presets, table
+from . import __version__, baking, cleanup, colour_management, examples, figures, lutfile, presets, render, table
 from .baking import BAKE_SINGLE_NODES
 from .models.rough import DIFFUSE_NODES
 from .paint import Paint
@@ -162,6 +162,11 @@ def _cmd_bake(args) -> int:
     paint = _paint_from_args(args)
     path, seconds = _bake_one(paint, args.out, args, paint.name or "bake")
     print(f"{path}  ({seconds:.2f} s)")
+    # The LUT holds the paint type; the colours are the renderer's inputs.
+    rbar = baking.load_lut(path).internal_reflectance
+    for name, value in render.node_inputs(paint, rbar).items():
+        shown = value if isinstance(value, float) else "(" + ", ".join(f"{v:.6g}" for v in value) + ")"
+        print(f"  {name}: {shown}")
     return 0
 
 

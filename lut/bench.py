@@ -218,3 +218,35 @@ def random_paints(count=24, seed=2026):
         kind = "smooth" if smooth else f"{distribution[:3]} {paint.slope:g}"
         out.append((f"#{i} {kind} g {paint.g:+.2f}", paint))
     return out
+
+
+def render_bake_times(paints, directory, repeat=1):
+    """Seconds of a cold ``lut.render.bake_for_render`` (the paint type's LUT
+    and every engine's fit, as the add-on's Bake does) per paint, split into
+    the LUT and the fits: [(label, lut seconds, fits seconds, total)]."""
+    import pathlib
+    import tempfile
+
+    from . import baking, fitting, render
+
+    rows = []
+    for label, paint in paints:
+        best = None
+        for _ in range(repeat):
+            with tempfile.TemporaryDirectory(dir=directory) as tmp:
+                start = time.perf_counter()
+                path = baking.bake(paint, tmp)
+                lut_done = time.perf_counter()
+                table = baking.load_lut(path)
+                for target in ("CYCLES", "EEVEE"):
+                    fitting.write_fit(fitting.fit_lut(table, target), fitting.fit_path(path, target))
+                end = time.perf_counter()
+                total = end - start
+                if best is None or total < best[2]:
+                    best = (lut_done - start, end - lut_done, total)
+                # The same through the one entry point, cached: what a second colour of the type costs.
+                cached_start = time.perf_counter()
+                render.bake_for_render(paint, pathlib.Path(tmp))
+                cached = time.perf_counter() - cached_start
+        rows.append((label, *best, cached))
+    return rows

@@ -72,9 +72,8 @@ def main(argv=None) -> int:
     addon.register()
     scene, spheres = build_scene(*args.size, args.samples)
     with tempfile.TemporaryDirectory() as tmp:
-        api.lut_directory = lambda: pathlib.Path(tmp)
         for sphere, name in zip(spheres, lut.PRESETS, strict=True):
-            sphere.data.materials.append(api.new_material(name, lut.preset(name)))
+            sphere.data.materials.append(api.new_material(name, lut.preset(name), directory=pathlib.Path(tmp)))
         with lutfile.atomic_target(args.out) as partial:
             scene.render.filepath = partial
             bpy.ops.render.render(write_still=True)

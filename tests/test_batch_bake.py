@@ -71,8 +71,15 @@ def test_bake_cache_edit_and_corruption(tmp_path):
     entry, status = statuses(report)
     assert status == {"red": "baked", "blue": "baked", "spare": "unused"}
     assert entry["status"] == "saved"
+    # red and blue differ in colour only: one paint type, baked once, shared.
     luts = sorted((tmp_path / "paint_lut").glob("paintlut-*.exr"))
-    assert len(luts) == 2
+    assert len(luts) == 1
+    key = luts[0].stem.removeprefix("paintlut-")
+    assert entry["shared"] == {key: ["blue", "red"]}
+    computed = sorted(entry["materials"][name]["computed"] for name in ("red", "blue"))
+    assert computed == [[], ["lut", "CYCLES", "EEVEE"]]  # the second found the first's bake
+    assert set(entry["materials"]["blue"]["fit"]) == {"CYCLES", "EEVEE"}
+    assert "one bake of paint type" in done.stdout and "shared by blue, red" in done.stdout
     assert not list(tmp_path.glob("*.partial*")) and not (tmp_path / "scene.blend1").exists()
     # The saved file refers to its LUTs relative to itself and is wired.
     bpy.ops.wm.open_mainfile(filepath=str(blend))
@@ -89,10 +96,15 @@ def test_bake_cache_edit_and_corruption(tmp_path):
     assert status == {"red": "cached", "blue": "cached", "spare": "unused"}
     assert entry["status"] == "unchanged" and blend.stat().st_mtime_ns == mtime
 
-    edit_blend(blend, "blue", rho=(0.9, 0.1, 0.1))
+    edit_blend(blend, "blue", rho=(0.9, 0.1, 0.1))  # a colour: a node input, nothing to bake
+    done = run(blend, "--report", report)
+    _, status = statuses(report)
+    assert status == {"red": "cached", "blue": "cached", "spare": "unused"}
+    edit_blend(blend, "blue", g=0.4)  # the paint type: a bake of its own
     done = run(blend, "--report", report)
     _, status = statuses(report)
     assert status == {"red": "cached", "blue": "baked", "spare": "unused"}
+    assert len(list((tmp_path / "paint_lut").glob("paintlut-*.exr"))) == 2
 
     # A damaged LUT is rebaked, not trusted and not a crash.
     bpy.ops.wm.open_mainfile(filepath=str(blend))
@@ -137,7 +149,7 @@ def test_parallel_jobs_give_the_same_report(tmp_path):
     assert done.returncode == 0, done.stderr
     entries = json.loads(report.read_text())
     assert [e["file"] for e in entries] == [str(f.resolve()) for f in files]
-    assert [e["materials"] for e in entries] == [{"m0": {"status": "baked"}}, {"m1": {"status": "baked"}}]
+    assert [{n: m["status"] for n, m in e["materials"].items()} for e in entries] == [{"m0": "baked"}, {"m1": "baked"}]
 
 
 def test_bad_arguments_name_the_parameter(tmp_path):

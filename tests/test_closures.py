@@ -135,11 +135,11 @@ def test_facet_dominated_dark_paints_keep_facet_closures(luts):
     for name in ("dark satin", "dark matte"):
         fitted = fitting.fit_lut(luts[name], "CYCLES")
         assert any(c.kind in ("metallic", "glossy", "sheen") for c in fitted.closures)
-        assert fitted.component_errors()["facet"] < 0.08
+        assert fitted.component_errors()["facet"] < 0.10
         black = lut.Paint(
             rho=0.0, slope=luts[name].meta["type"]["slope"], distribution=luts[name].meta["type"]["distribution"]
         )
-        assert fitted.error(luts[name].amplitudes(black)) < 0.08
+        assert fitted.error(luts[name].amplitudes(black)) < 0.10
 
 
 def test_fits_respect_the_budget_and_the_mix_factor_bound(luts):

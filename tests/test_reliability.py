@@ -71,7 +71,7 @@ def test_the_partial_file_of_a_killed_writer_is_removed_by_the_next_bake(tmp_pat
         assert child.stdout.readline().strip() == "writing"
         partials = list(tmp_path.glob(".*.partial*"))
         assert len(partials) == 1
-        lut.bake(lut.Paint(rho=0.6), tmp_path, resolution=(8, 6, 4))  # another paint: the writer still runs
+        lut.bake(lut.Paint(n=1.6, rho=0.6), tmp_path, resolution=(8, 6, 4))  # another type: the writer still runs
         assert partials[0].exists()
     finally:
         child.send_signal(signal.SIGKILL)
@@ -194,8 +194,9 @@ def test_files_that_are_not_utf8_are_named(tmp_path, capsys):
 
 
 def _baked_paint(capsys):
-    path = capsys.readouterr().out.split()[0]
-    return lut.load_lut(path).meta["paint"]
+    """The type the printed LUT holds, and the colour inputs printed with it."""
+    out = capsys.readouterr().out
+    return {**lut.load_lut(out.split()[0]).meta["type"], "out": out}
 
 
 def test_options_override_a_preset_and_a_paint_file(tmp_path, capsys):
@@ -206,7 +207,7 @@ def test_options_override_a_preset_and_a_paint_file(tmp_path, capsys):
     toml.write_text("rho = 0.4\nslope = 0.1\n")
     assert main(["bake", "--paint", str(toml), "--slope", "0.3", "--out", str(tmp_path), *SMALL]) == 0
     paint = _baked_paint(capsys)
-    assert paint["slope"] == 0.3 and paint["rho"] == [0.4, 0.4, 0.4]
+    assert paint["slope"] == 0.3 and "Pigment Color: (0.4, 0.4, 0.4)" in paint["out"]
     # An override the preset cannot take is refused, not ignored.
     assert main(["bake", "--preset", "glossy_red", "--rho", "0.1", "0.2", "0.3", "--out", str(tmp_path)]) == 2
     assert "rho must be a Spectrum or a grey value in a spectral paint" in _error_line(capsys)
@@ -260,9 +261,9 @@ def test_clean_removes_only_luts_and_weights_nothing_keeps(tmp_path, capsys):
     from lut import cleanup
 
     kept = lut.bake(lut.Paint(rho=0.2), tmp_path, resolution=(8, 6, 4))
-    gone = lut.bake(lut.Paint(rho=0.7), tmp_path, resolution=(8, 6, 4))
+    gone = lut.bake(lut.Paint(n=1.6, rho=0.7), tmp_path, resolution=(8, 6, 4))  # another paint type
     for path in (kept, gone):
-        for prefix in ("paintfit-", "paintfit-eevee-"):
+        for prefix in ("paintfit-cycles-", "paintfit-eevee-"):
             path.with_name(path.name.replace("paintlut-", prefix)).write_bytes(b"weights")
     other = tmp_path / "notes.exr"
     other.write_bytes(b"x")
@@ -276,7 +277,7 @@ def test_clean_removes_only_luts_and_weights_nothing_keeps(tmp_path, capsys):
     assert "would remove 4 file(s)" in capsys.readouterr().out
     assert main(["clean", str(tmp_path), "--keep", str(kept)]) == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
-        [kept.name, "notes.exr", kept.name.replace("paintlut-", "paintfit-"),
+        [kept.name, "notes.exr", kept.name.replace("paintlut-", "paintfit-cycles-"),
          kept.name.replace("paintlut-", "paintfit-eevee-")]
     )  # fmt: skip
     assert "removed 4 file(s)" in capsys.readouterr().out

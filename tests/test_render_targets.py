@@ -7,38 +7,29 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-from blender_oracle import EEVEE, Oracle, paints, relative_rms  # noqa: E402
+from blender_oracle import EEVEE, Oracle, paint_material, paints, relative_rms  # noqa: E402
 
-import addon  # noqa: E402
-from addon import api, nodes  # noqa: E402
+pytestmark = pytest.mark.render
 
 
 @pytest.fixture
-def registered(tmp_path, monkeypatch):
-    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
+def registered():
+    import addon
+
     addon.register()
     yield
     addon.unregister()
 
 
-def _baked(oracle, paint, monkeypatch):
-    monkeypatch.setattr(api, "paint_of", lambda material: paint)
-    material = oracle.material()
-    api.bake_material(material, resolution=(8, 6, 4))
-    return material
-
-
-def test_eevee_renders_its_own_fit(registered, monkeypatch):
+def test_eevee_renders_its_own_fit(registered, tmp_path):
     oracle = Oracle(engine=EEVEE)
     try:
         oracle.radiance(0.3, 0.3, 1.0)
     except RuntimeError as exc:  # no GPU context (no EGL/Mesa) on this machine
         pytest.skip(f"EEVEE cannot render here: {exc}")
     paint = paints()["glossy white"]
-    material = _baked(oracle, paint, monkeypatch)
+    material, _ = paint_material(oracle, paint, tmp_path)
     grid = (np.radians([10, 45, 70]), np.radians([10, 50]), (0.8, 2.4))
-    # scripts/render_fidelity.py measured 1.6% on its grid; the Cycles group
-    # (Toon closures, which EEVEE draws as Lambert) is about 15% off in EEVEE.
     assert relative_rms(oracle, paint, grid) < 0.04
     # The Cycles output is not what EEVEE drew: point EEVEE at it and the error grows.
     material.node_tree.get_output_node("EEVEE").is_active_output = False
@@ -48,13 +39,14 @@ def test_eevee_renders_its_own_fit(registered, monkeypatch):
     assert relative_rms(oracle, paint, grid) > 0.08
 
 
-def test_principled_facet_lobes_for_blender_4(registered, monkeypatch):
+def test_principled_facet_lobes_for_blender_4(registered, tmp_path):
     """Blender 4.2-4.5 get Principled (GGX, black base) facet lobes: exact
     Fresnel, GGX instead of Beckmann; the satin paint stays within 5%."""
-    monkeypatch.setattr(nodes, "EXACT_METALLIC", False)
+    from addon import nodes
+
     oracle = Oracle()
     paint = paints()["satin"]
-    material = _baked(oracle, paint, monkeypatch)
+    material, _ = paint_material(oracle, paint, tmp_path, exact_metallic=False)
     group = nodes.group_of(material).node_tree
     assert any(nd.type == "BSDF_PRINCIPLED" for nd in group.nodes)
     assert not any(nd.type == "BSDF_METALLIC" for nd in group.nodes)
