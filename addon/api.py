@@ -81,6 +81,8 @@ def store_result(material, paint: lut.Paint, result: render.RenderBake, exact_me
     }
     nodes.wire(material, groups, render.node_inputs(paint, result.lut.internal_reflectance))
     settings.internal_reflectance = result.lut.internal_reflectance
+    settings.diffuse_albedo = render.diffuse_albedo(result.lut)
+    nodes.build_seen_group(result.fits[next(iter(result.fits))], settings.diffuse_albedo)
     settings.fits = json.dumps(
         {target: {"residual": f.residual.tolist(), "reference": f.reference.tolist(), "goal": f.target_error}
          for target, f in result.fits.items()}
@@ -258,14 +260,19 @@ def is_current(material, paint, *, directory=None, exact_metallic=None, **option
         return False
     try:
         table = lut.load_lut(path)
+        if not path.stem.endswith(table.key[:24]):  # another type's LUT renamed onto this one's name
+            return False
         for target in engine_targets():
-            fitted = lut.fitting.read_fit(lut.fitting.fit_path(path, target, exact))
-            if fitted.lut_key != table.key:
+            fit_file = lut.fitting.fit_path(path, target, exact)
+            fitted = lut.fitting.read_fit(fit_file)
+            if fitted.lut_key != table.key or fitted.target != target:
                 return False
             node = nodes.group_of(material, target)
             if node is None or not nodes.is_paint_group(node.node_tree):
                 return False
             if node.node_tree.get("paint_lut_fit", "").split(":")[0] != table.key:
+                return False
+            if nodes.group_weights_path(node.node_tree) != fit_file.resolve():  # e.g. after Save As elsewhere
                 return False
     except lut.LUTError:
         return False

@@ -25,6 +25,8 @@ group node per render engine, each into a Material Output targeted at it."""
 
 from __future__ import annotations
 
+import pathlib
+
 import bpy
 
 from lut import closures, fitting, lutfile
@@ -136,7 +138,11 @@ def build_group(fit: fitting.Fit, weights_path, exact_metallic=None):
     name = group_name(fit)
     fit_id = _fit_id(fit, weights_path)
     old = bpy.data.node_groups.get(name)
-    if old is not None and old.get("paint_lut_fit") == fit_id:
+    if (
+        old is not None
+        and old.get("paint_lut_fit") == fit_id
+        and group_weights_path(old) == pathlib.Path(weights_path).resolve()
+    ):
         return old
     if old is not None:
         old.name = f"{name} (old)"  # materials that use it keep it until rewired
@@ -187,6 +193,15 @@ def build_group(fit: fitting.Fit, weights_path, exact_metallic=None):
         total = tree.nodes.new("ShaderNodeBsdfTransparent").outputs[0]
     links.new(total, out.inputs["Shader"])
     return group
+
+
+def group_weights_path(group):
+    """The absolute path of the weights image a paint group reads (None
+    when it has none)."""
+    image = next((nd.image for nd in group.nodes if nd.type == "TEX_IMAGE" and nd.image), None)
+    if image is None:
+        return None
+    return pathlib.Path(bpy.path.abspath(image.filepath, library=image.library)).resolve()
 
 
 def _interface(group):
@@ -404,6 +419,50 @@ NODE_BUILDERS = {
     "oren_nayar": _oren_nayar,
 }
 assert set(NODE_BUILDERS) == set(closures.CLOSURE_KINDS)
+
+
+def build_seen_group(fit: fitting.Fit, albedo: float):
+    """A small group for colours picked as seen: ``Color (as seen)`` (the
+    diffuse colour head-on, k(ρ)·a_D) in, the ``Pigment Color`` ρ that gives
+    it out (k = min(colour/a_D, 1), ρ = k/(1 - r̄ + k r̄)).  Put it between a
+    texture painted in seen colours and the paint group's Pigment Color."""
+    name = f"{GROUP_PREFIX} As Seen {fit.lut_key[:8]}"
+    group = bpy.data.node_groups.get(name)
+    if group is not None and group.get("paint_lut_albedo") == round(albedo, 9):
+        return group
+    if group is None:
+        group = bpy.data.node_groups.new(name, "ShaderNodeTree")
+    group.nodes.clear()
+    group.interface.clear()
+    group["paint_lut_albedo"] = round(albedo, 9)
+    if hasattr(group, "description"):
+        group.description = "Paint LUT: the pigment colour rho that shows a given diffuse colour head-on"
+    socket = group.interface.new_socket(name="Color (as seen)", in_out="INPUT", socket_type="NodeSocketColor")
+    socket.default_value = (0.5, 0.5, 0.5, 1.0)
+    group.interface.new_socket(name="Pigment Color", in_out="OUTPUT", socket_type="NodeSocketColor")
+    nodes_, links = group.nodes, group.links
+    inp, out = nodes_.new("NodeGroupInput"), nodes_.new("NodeGroupOutput")
+    steps = []
+    for op, label in (("SCALE", "k = colour / albedo"), ("MINIMUM", "k <= 1"), ("MULTIPLY_ADD", "k rbar + 1 - rbar"),
+                      ("DIVIDE", "rho = k / (...)")):  # fmt: skip
+        node = nodes_.new("ShaderNodeVectorMath")
+        node.operation, node.label = op, label
+        steps.append(node)
+    scale, cap, den, div = steps
+    links.new(inp.outputs[0], scale.inputs[0])
+    scale.inputs["Scale"].default_value = 1.0 / albedo
+    links.new(scale.outputs[0], cap.inputs[0])
+    cap.inputs[1].default_value = (1.0, 1.0, 1.0)
+    rbar = fit.internal_reflectance
+    links.new(cap.outputs[0], den.inputs[0])
+    den.inputs[1].default_value = (rbar, rbar, rbar)
+    den.inputs[2].default_value = (1.0 - rbar,) * 3
+    links.new(cap.outputs[0], div.inputs[0])
+    links.new(den.outputs[0], div.inputs[1])
+    links.new(div.outputs[0], out.inputs[0])
+    for i, node in enumerate([inp, *steps, out]):
+        node.location = (220.0 * i, 0.0)
+    return group
 
 
 def _node_name(target):

@@ -13,6 +13,7 @@ def draw_settings(layout, material):
     col.use_property_split = True
     col.use_property_decorate = False
     col.label(text="Colours (live: no bake)")
+    col.prop(settings, "seen")
     col.prop(settings, "rho")
     col.prop(settings, "single")
     col.prop(settings, "facet")

@@ -16,6 +16,7 @@ import json
 import bpy
 
 import lut
+import lut.models
 import lut.render
 
 PRESET_ITEMS = [
@@ -119,6 +120,26 @@ def _exact(value):
     return round(float(value), 6)
 
 
+def _seen_constants(settings):
+    """(a_D, r̄) of the baked type; before a bake those of the smooth
+    interface of the same index (exact for smooth paints)."""
+    if settings.diffuse_albedo > 0 and settings.internal_reflectance > 0:
+        return settings.diffuse_albedo, settings.internal_reflectance
+    n = _exact(settings.n)
+    rs, rp = lut.models.fresnel.reflection_coefficients(1.0, n)
+    return float(1.0 - 0.5 * (rs**2 + rp**2)), lut.models.internal_reflectance(n)
+
+
+def _get_seen(self):
+    albedo, rbar = _seen_constants(self)
+    return tuple(float(v) for v in lut.render.seen_of_pigment(tuple(self.rho), albedo, rbar))
+
+
+def _set_seen(self, value):
+    albedo, rbar = _seen_constants(self)
+    self.rho = tuple(float(v) for v in lut.render.pigment_of_seen(value, albedo, rbar))
+
+
 class PaintLUTSettings(bpy.types.PropertyGroup):
     enabled: bpy.props.BoolProperty(
         name="Use Paint LUT", default=False, description="Render this material as a Paint LUT paint",
@@ -167,6 +188,15 @@ class PaintLUTSettings(bpy.types.PropertyGroup):
     internal_reflectance: bpy.props.FloatProperty(
         name="Internal Reflectance", default=0.0, options={"HIDDEN"},
         description="r-bar of the baked paint type (turns the pigment colour into the diffuse amplitude)",
+    )  # fmt: skip
+    diffuse_albedo: bpy.props.FloatProperty(
+        name="Diffuse Albedo", default=0.0, options={"HIDDEN"},
+        description="a_D of the baked paint type: the head-on diffuse colour of a white pigment",
+    )  # fmt: skip
+    seen: bpy.props.FloatVectorProperty(
+        name="Color as Seen", subtype="COLOR", size=3, min=0.0, max=1.0, get=_get_seen, set=_set_seen,
+        description="The diffuse colour the paint shows head-on (k(rho) times the interface's albedo); "
+        "setting it sets the Pigment Color that shows it (beyond what a white pigment shows, it is limited)",
     )  # fmt: skip
     fits: bpy.props.StringProperty(
         name="Fit Errors", options={"HIDDEN"},

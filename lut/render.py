@@ -142,3 +142,30 @@ def amplitudes_of_inputs(inputs: dict, internal_reflectance: float) -> np.ndarra
         ],
         axis=1,
     )
+
+
+def diffuse_albedo(table) -> float:
+    """a_D: the directional-hemispherical reflectance at normal incidence of
+    the diffuse component at ρ = 1 (∫ B_D(0, θs, φs) cos θs dω), from a
+    loaded LUT; for a smooth interface 1 - R(0) (all light that enters comes
+    out when nothing is absorbed), less for a rough one.  The diffuse colour
+    an artist sees head-on is k(ρ)·a_D."""
+    x, w = np.polynomial.legendre.leggauss(48)
+    theta = 0.25 * np.pi * (x + 1.0)
+    weights = 0.25 * np.pi * w * np.cos(theta) * np.sin(theta)
+    phi = (np.arange(24) + 0.5) * 2 * np.pi / 24 - np.pi
+    comps = table.components(0.0, theta[:, None], phi[None, :])[..., 0, 2]  # (θ, φ): the diffuse component
+    return float(np.sum(comps.mean(axis=1) * weights) * 2 * np.pi)
+
+
+def pigment_of_seen(colour, albedo: float, internal_reflectance: float) -> np.ndarray:
+    """The pigment ρ whose diffuse colour seen head-on is ``colour``: k =
+    colour/a_D, ρ = k/(1 - r̄ + k r̄); colours beyond a_D (what ρ = 1 gives)
+    are limited to it."""
+    k = np.clip(np.asarray(colour, dtype=float) / albedo, 0.0, 1.0)
+    return pigment_of_amplitude(k, internal_reflectance)
+
+
+def seen_of_pigment(rho, albedo: float, internal_reflectance: float) -> np.ndarray:
+    """The diffuse colour seen head-on of a pigment ρ: k(ρ)·a_D."""
+    return diffuse_amplitude(rho, internal_reflectance) * albedo

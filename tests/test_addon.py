@@ -338,3 +338,61 @@ def test_saved_files_reference_luts_relatively(fresh_file, tmp_path):
     assert (tmp_path / "paint_lut").is_dir()
     assert "UNDO" in operators.PAINTLUT_OT_bake.bl_options
     assert json.loads(material.paint_lut.fits).keys() == {"CYCLES", "EEVEE"}
+
+
+def test_save_as_elsewhere_rebakes_what_points_at_the_old_folder(fresh_file, tmp_path):
+    """Save As into another folder (paint_lut/ copied along): Blender remaps
+    the images to the old folder; the bake is not current there until it
+    is wired to the new folder's files."""
+    import shutil
+
+    from addon import api, nodes
+
+    (tmp_path / "a").mkdir()
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "a" / "scene.blend"))
+    material = api.new_material("paint", lut.Paint(rho=0.5), **SMALL)
+    material.use_fake_user = True
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "a" / "scene.blend"))
+    shutil.copytree(tmp_path / "a" / "paint_lut", tmp_path / "b" / "paint_lut")
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "b" / "scene.blend"))
+    material = bpy.data.materials["paint"]
+    paint = api.paint_of(material)
+    assert not api.is_current(material, paint, **SMALL)
+    assert api.bake_materials({material}, **SMALL) == {"paint": "baked"}
+    assert api.is_current(material, paint, **SMALL)
+    weights = nodes.group_weights_path(_group_node(material).node_tree)
+    assert weights.parent == (tmp_path / "b" / "paint_lut").resolve()
+
+
+def test_a_foreign_lut_renamed_onto_a_materials_name_is_not_trusted(material, lut_dir):
+    from addon import api
+
+    api.bake_material(material, directory=lut_dir, **SMALL)
+    mine = lut.lut_path(api.paint_of(material), lut_dir, **SMALL)
+    other = lut.bake(lut.Paint(n=1.7), lut_dir / "other", **SMALL)
+    other.replace(mine)
+    assert not api.is_current(material, api.paint_of(material), directory=lut_dir, **SMALL)
+
+
+def test_colour_as_seen_sets_the_pigment_that_shows_it(material, lut_dir):
+    """The diffuse colour seen head-on is k(ρ)·a_D: setting it sets ρ (live),
+    a white pigment's is the interface's transmittance (1 - R(0) when
+    smooth), and the As Seen group computes the same ρ in nodes."""
+    from addon import api
+
+    api.bake_material(material, directory=lut_dir)  # a smooth type: the default resolution is quick
+    settings = material.paint_lut
+    assert settings.diffuse_albedo == pytest.approx(0.96, abs=2e-4)  # n = 1.5: 1 - R(0) = 0.96
+    settings.seen = (0.5, 0.2, 0.05)
+    assert tuple(settings.seen) == pytest.approx((0.5, 0.2, 0.05), abs=1e-5)
+    rho = lut.paint.pigment_of_amplitude(
+        np.array([0.5, 0.2, 0.05]) / settings.diffuse_albedo, settings.internal_reflectance
+    )
+    assert tuple(settings.rho) == pytest.approx(tuple(rho), abs=1e-5)
+    assert not settings.stale and _inputs(material)["Pigment Color"] == pytest.approx(tuple(rho), abs=1e-5)
+    assert rho[0] > 0.5  # the pigment is lighter than what is seen through the interface
+    seen_group = next(g for g in bpy.data.node_groups if g.name.startswith("Paint LUT As Seen"))
+    assert {(s.name, s.in_out) for s in seen_group.interface.items_tree} == {
+        ("Color (as seen)", "INPUT"),
+        ("Pigment Color", "OUTPUT"),
+    }

@@ -213,3 +213,26 @@ def test_ggx_closure_is_principled_with_a_black_base(oracle, n, roughness):
     for geometry in ((0.5, 0.5, 0.0), (0.3, 0.6, 0.4), (0.8, 0.7, 0.3), (0.2, 0.25, 3.0), (1.1, 1.0, 0.1)):
         got = oracle.radiance(*geometry)[0] / oracle.irradiance
         assert got == pytest.approx(float(closure.evaluate(*geometry)), rel=2e-3)
+
+
+def test_the_as_seen_group_computes_the_pigment_in_nodes(registered_oracle, tmp_path):
+    """Rendered as emission, the As Seen group's output is the pigment ρ that
+    lut.render.pigment_of_seen gives (the panel's own inversion)."""
+    import bpy
+
+    from lut import render
+
+    oracle = registered_oracle
+    material, result = paint_material(oracle, lut.Paint(rho=0.5, slope=0.3), tmp_path, resolution=(16, 8, 4))
+    group = next(g for g in bpy.data.node_groups if g.name.startswith("Paint LUT As Seen"))
+    tree = material.node_tree
+    node = tree.nodes.new("ShaderNodeGroup")
+    node.node_tree = group
+    seen = (0.6, 0.25, 0.02)
+    node.inputs["Color (as seen)"].default_value = (*seen, 1.0)
+    emission = tree.nodes.new("ShaderNodeEmission")
+    tree.links.new(node.outputs["Pigment Color"], emission.inputs["Color"])
+    tree.links.new(emission.outputs[0], tree.get_output_node("CYCLES").inputs["Surface"])
+    albedo = material.paint_lut.diffuse_albedo
+    want = render.pigment_of_seen(seen, albedo, result.lut.internal_reflectance)
+    np.testing.assert_allclose(oracle.radiance(0.3, 0.2, 1.0), want, rtol=1e-5)
