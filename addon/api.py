@@ -109,6 +109,19 @@ def bake_material(material, *, directory=None, force=False, exact_metallic=None,
     return result
 
 
+def finish_background_bake(material, paint, result, type_key_at_start) -> bool:
+    """Store a background bake's result on its material.  If the paint type
+    was edited while the bake ran, the result is wired (it is a valid bake of
+    the type it was started with) but the material stays stale: the panel
+    never says baked for a type it did not bake.  The colours are inputs and
+    are sent again either way.  Returns whether the material is current."""
+    current = material.paint_lut.type_key() == type_key_at_start
+    store_result(material, paint, result, clear_stale=current)
+    update_inputs(material)
+    material.paint_lut.enabled = True
+    return current
+
+
 def update_inputs(material) -> None:
     """Send a material's colours (pigment, single scattering, surface
     reflection) to its paint groups' inputs: a colour edit needs no bake."""

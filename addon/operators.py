@@ -78,12 +78,7 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
             level = {"WARNING"} if self._job.cancelled else {"ERROR"}
             self.report(level, f"Paint LUT: {self._job.error}")
             return {"CANCELLED"}
-        # The paint type edited while the bake ran: wire what was baked but
-        # leave the material stale (its colours are inputs: always current).
-        changed = self._material.paint_lut.type_key() != self._type_key
-        api.store_result(self._material, self._paint, self._job.result, clear_stale=not changed)
-        api.update_inputs(self._material)
-        self._material.paint_lut.enabled = True
+        api.finish_background_bake(self._material, self._paint, self._job.result, self._type_key)
         self._report_fit(self._material)
         self.report({"INFO"}, f"Baked {self._job.result.lut_path.name}")
         return {"FINISHED"}

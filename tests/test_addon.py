@@ -396,3 +396,27 @@ def test_colour_as_seen_sets_the_pigment_that_shows_it(material, lut_dir):
         ("Color (as seen)", "INPUT"),
         ("Pigment Color", "OUTPUT"),
     }
+
+
+def test_a_type_edited_during_a_background_bake_stays_stale(material, tmp_path):
+    """The operator's background bake finishes after the artist changed the
+    slope: the material is wired to what was baked but stays stale; a colour
+    edited meanwhile reaches the groups."""
+    from addon import api, jobs
+
+    settings = material.paint_lut
+    settings.slope = 0.2
+    paint, started = api.paint_of(material), settings.type_key()
+    job = jobs.BakeJob(paint, tmp_path, **SMALL).start()
+    settings.slope = 0.4  # edited while the bake runs
+    settings.rho = (0.2, 0.6, 0.1)
+    assert job.wait(120) and job.error is None
+    assert api.finish_background_bake(material, paint, job.result, started) is False
+    assert settings.stale and _group_node(material) is not None
+    assert _inputs(material)["Pigment Color"] == pytest.approx((0.2, 0.6, 0.1))
+    settings.slope = 0.2  # back to the baked type: a fresh bake of it is current
+    job = jobs.BakeJob(api.paint_of(material), tmp_path, **SMALL).start()
+    assert job.wait(120) and api.finish_background_bake(
+        material, api.paint_of(material), job.result, settings.type_key()
+    )
+    assert not settings.stale
