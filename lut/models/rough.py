@@ -287,7 +287,8 @@ def _prepare(theta, n, slope, distribution, nodes, entering):
     jones = geometry.interface_jones(
         st["k"], st["k_in"], st["h"], st["t_s"], st["t_p"], geometry.sp_basis(st["k"]), (s_loc, p_int)
     )
-    # At φs = 0 the exit's global basis turns rigidly with the azimuth (θs > 0).
+    # Computed at φs = 0; the exit's global basis turns rigidly with the
+    # azimuth (at θs = 0 as well: s = ŷ is the limit along φs = 0).
     st["J"] = jones if entering else np.swapaxes(jones, -1, -2)
     return st
 
@@ -301,8 +302,6 @@ def _single_sum(ti, ts, ps, n, g, slope, distribution, nodes_in, nodes_out, muel
     exit_ = _prepare(us, n, slope, distribution, nodes_out, entering=False)
     m_in, m_out = entry["w"].shape[-1], exit_["w"].shape[-1]
     lit = (ti < np.pi / 2) & (ts < np.pi / 2)
-    # At θs = 0 the global s/p basis of k_s is ŷ/-x̂ whatever φs: do not rotate it.
-    basis_rot = ts > 0.0
     out = np.zeros(ti.shape + ((4, 4) if mueller else ()))
     chunk = max(1, CHUNK_PAIRS // (m_in * m_out))
     for start in range(0, ti.size, chunk):
@@ -332,18 +331,10 @@ def _single_sum(ti, ts, ps, n, g, slope, distribution, nodes_in, nodes_out, muel
             out[sl] = np.sum(weight * m00, axis=(1, 2))
             continue
         v = np.stack((np.stack((v_ss, v_sp), -1), np.stack((v_ps, v_pp), -1)), -2)
-        bmat = b["J"]
-        # Rotating the exit states by φs leaves B unchanged except at θs = 0,
-        # where the global basis stays fixed while the local one turns.
-        rot = ~basis_rot[sl]
-        if np.any(rot):
-            c1, s1 = cp[rot, :, None, None], sp[rot, :, None, None]
-            r = np.concatenate(
-                (np.concatenate((c1, s1), -1), np.concatenate((-s1, c1), -1)), -2
-            )  # (c, 1, 2, 2): rotation of the s/p components by -φs
-            bmat = bmat.copy()
-            bmat[rot] = np.matmul(r, bmat[rot])
-        jones = np.matmul(np.matmul(bmat[:, None, :, :, :], v), a["J"][:, :, None, :, :])
+        # Rotating the exit states by φs leaves B unchanged: the exit ray's
+        # global basis turns rigidly with them, at θs = 0 too (the limit along
+        # φs, as for every model; docs/models.md, Conventions).
+        jones = np.matmul(np.matmul(b["J"][:, None, :, :, :], v), a["J"][:, :, None, :, :])
         out[sl] = np.sum(weight[..., None, None] * jones_to_mueller(jones), axis=(1, 2))
     out[~lit] = 0.0
     return out.reshape(shape + ((4, 4) if mueller else ()))
