@@ -58,10 +58,11 @@ def test_normal_exit_rotates_with_phi_as_a_change_of_basis(fn, kw, theta_i):
 @pytest.mark.parametrize(("fn", "kw"), ROUGH, ids=_id)
 def test_rough_models_at_normal_exit_rotate_like_the_smooth_ones(fn, kw):
     """The rough models' exit facets turn rigidly with φs, so at θs = 0 only
-    the quadrature's orientation changes (its error, ~1e-5 here); the basis
-    rotation moves the polarization elements by up to M00."""
+    the quadrature's orientation changes (within its error, up to 4e-4 of
+    M00 here); the basis rotation moves the polarization elements by up to
+    M00."""
     for theta_i in (0.5, 0.0):
-        rotated, at_zero, scale = _check_exit_rotation(fn, kw, theta_i, 1e-4)
+        rotated, at_zero, scale = _check_exit_rotation(fn, kw, theta_i, 1e-3)
         if fn is models.rough_single:
             assert np.max(np.abs(rotated - at_zero)) > 0.05 * scale
 

@@ -9,11 +9,12 @@ for the scattered ray from the slope distribution as seen by that ray
   viewer) the facets it meets have density P(ζ) max(cos ι, 0) sec θn per
   dζx dζy (Eq. 36), normalized exactly (each ray meets one facet; the paper's
   Eq. 37 approximates the normalization by cos θ).  We integrate it with a
-  product Gauss rule: Gauss-Legendre in the radial slope ζ for the measure
-  2πζP(ζ)dζ (``distributions.radial_rule``) times Gauss-Legendre in the facet
-  azimuth over the arc where cos ι > 0.  The rule moves smoothly with the
-  direction, so results are smooth in angle, and it is deterministic, so no
-  seed is needed.
+  product rule: in the radial slope, Gauss rules of the measure 2πζP(ζ)dζ
+  split where facets start to turn away from the ray
+  (``distributions.split_radial_rule``), times the periodic trapezoid rule
+  (full circle) or Gauss-Legendre (the arc where cos ι > 0) in the facet
+  azimuth.  The rule moves smoothly with the direction, so results are
+  smooth in angle, and it is deterministic, so no seed is needed.
 
 * **Diffuse term** (Eq. 21 under a rough interface).  The substrate is
   depolarizing and its emitted radiance is uniform, so the BRDF factors:
@@ -73,9 +74,11 @@ def visible_normals(theta, slope: float, distribution: str, nodes):
     A facet with slope ζ at azimuth φ (from u's azimuth) faces u where
     cos θ + ζ sin θ cos φ > 0, i.e. for every φ while ζ < cot θ and on an arc
     |φ| < arccos(-cot θ / ζ) beyond.  The radial integral is split at
-    ζ = cot θ (``distributions.split_radial_rule``): inside, the azimuth runs
-    over the whole circle (periodic trapezoid rule, spectrally accurate);
-    outside, over the visible arc (Gauss-Legendre).  Each facet's weight is
+    ζ = cot θ, or nearer the middle of the facets when that lies far in the
+    tail (``distributions.split_radial_rule``, which has the Gauss rule of
+    each piece): inside, the azimuth runs over the whole circle (periodic
+    trapezoid rule, spectrally accurate); outside, over the visible arc
+    (Gauss-Legendre).  Each facet's weight is
     its share of the projected area, max(cos ι, 0) sec θn (Eq. 36), and the
     weights are normalized to sum to 1.
 
@@ -99,8 +102,13 @@ def visible_normals(theta, slope: float, distribution: str, nodes):
     half = np.where(clipped, np.arccos(np.clip(ratio, -1.0, 1.0)), np.pi)
     x, w_x = np.polynomial.legendre.leggauss(n_phi)
     trap = (2.0 * np.arange(n_phi) + 1.0) / n_phi - 1.0  # periodic trapezoid on [-1, 1)
-    unit = np.where(clipped[..., None], x, trap)
-    w_unit = np.where(clipped[..., None], w_x, 2.0 / n_phi)
+    # The rule follows the radial piece, not the node's own visibility: the
+    # outer piece can begin before ζ = cot θ (where that lies beyond the
+    # split cap), and its nodes' arcs must shrink continuously from π as θ
+    # grows, so they always use Gauss-Legendre.
+    outer = (np.arange(2 * n_zeta) >= n_zeta)[:, None]
+    unit = np.where(outer, x, trap)
+    w_unit = np.where(outer, w_x, 2.0 / n_phi)
     phi = half[..., None] * unit
     w_phi = half[..., None] * w_unit / (2.0 * np.pi)
     zeta_ = zeta[..., None]
