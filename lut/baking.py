@@ -29,7 +29,7 @@ from .models.rough import DIFFUSE_NODES
 from .paint import COMPONENTS, Paint
 
 #: Bumped whenever a model change alters baked values, so old caches miss.
-MODEL_VERSION = 1
+MODEL_VERSION = 2
 #: Quadrature of the rough single-scatter term in bakes: coarser than the
 #: model's own default (4, 6) because the table's interpolation error
 #: dominates; the bake benchmark shows no gain from (4, 6) at 2.8x the time.

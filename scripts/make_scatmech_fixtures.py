@@ -30,10 +30,34 @@ SDF = {
 }
 
 
+#: Normal exit (θs = 0) and normal incidence (θi = 0) at azimuths other than
+#: 0 and π, where the polarization basis of the normal ray is the limit along
+#: φs; each normal-exit θi also appears at φs = 0, its twin in the fixed basis.
+NORMAL_EDGES = [
+    (0.0488, 0.0, -0.0708),
+    (0.0488, 0.0, 0.0),
+    (0.3, 0.0, 0.7),
+    (0.3, 0.0, 0.0),
+    (0.9, 0.0, -1.9),
+    (0.9, 0.0, 2.6),
+    (0.9, 0.0, 0.0),
+    (0.6, 0.0, np.pi / 2),
+    (0.6, 0.0, 0.0),
+    (1.2, 0.0, -2.3),
+    (1.2, 0.0, 0.0),
+    (0.0, 0.0, 0.7),
+    (0.0, 0.0, -2.2),
+    (0.0, 0.2, 1.1),
+    (0.0, 0.8, -2.4),
+    (0.0, 1.3, 3.0),
+    (0.0, 0.5, -np.pi / 2),
+]
+
+
 def geometries(rng, count, max_theta=1.45):
     """Random geometries plus the edges: normal incidence, normal exit (φ = 0),
-    in-plane (φ = 0 and π exactly), the specular and retro directions, and
-    near-grazing angles."""
+    in-plane (φ = 0 and π exactly), the specular and retro directions,
+    near-grazing angles, and NORMAL_EDGES."""
     ti = list(rng.uniform(0, max_theta, count))
     ts = list(rng.uniform(0, max_theta, count))
     ps = list(rng.uniform(-np.pi, np.pi, count))
@@ -49,7 +73,7 @@ def geometries(rng, count, max_theta=1.45):
         (0.5, 1.5533, 2.0),
         (1.5533, 1.5533, 0.0),
     ]
-    for a, b, c in edges:
+    for a, b, c in edges + NORMAL_EDGES:
         ti.append(a)
         ts.append(b)
         ps.append(c)

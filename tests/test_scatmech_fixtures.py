@@ -7,6 +7,7 @@ import pathlib
 
 import numpy as np
 import pytest
+from helpers import normal_basis_rotation
 
 from lut import models
 
@@ -24,6 +25,29 @@ def _evaluate(case):
     return fn(np.array(case["theta_i"]), np.array(case["theta_s"]), np.array(case["phi_s"]), **case["params"])
 
 
+def _scatmech_fixes_basis(case):
+    """Where SCATMECH keeps s = ŷ for the normal exit ray whatever φs (its
+    ``First_Diffuse_BRDF_Model`` at every θs = 0; its ``Facet_BRDF_Model``
+    only at θi = θs = 0, where its facet is met head-on), while everywhere
+    else it, and every model here, takes the limit along φs."""
+    ti, ts = np.array(case["theta_i"]), np.array(case["theta_s"])
+    if case["model"] == "smooth_single":
+        return ts == 0.0
+    if case["model"].startswith("facet"):
+        return (ts == 0.0) & (ti == 0.0)
+    return np.zeros(ti.shape, dtype=bool)
+
+
+def _reference(case):
+    """SCATMECH's values, in the φs-limit basis at normal exit (see
+    ``_scatmech_fixes_basis``)."""
+    ref = np.array(case["mueller"])
+    fixed = _scatmech_fixes_basis(case)
+    transmitted = case["model"] == "facet_transmission"
+    ref[fixed] = normal_basis_rotation(np.array(case["phi_s"])[fixed], transmitted) @ ref[fixed]
+    return ref
+
+
 def _relative_error(ours, ref):
     scale = ref[:, 0, 0]
     lit = scale > 0
@@ -38,9 +62,37 @@ def test_fixture_covers_every_model():
     assert sum(len(c["theta_i"]) for c in CASES) > 1500
 
 
+def test_fixture_has_normal_rays_at_several_azimuths():
+    for case in CASES:
+        ti, ts, ps = (np.array(case[k]) for k in ("theta_i", "theta_s", "phi_s"))
+        odd = np.abs(np.sin(ps)) > 0.05
+        assert np.sum((ts == 0.0) & (ti > 0.0) & odd) >= 5
+        assert np.sum((ti == 0.0) & (ts > 0.0) & odd) >= 4
+        assert np.sum((ti == 0.0) & (ts == 0.0) & odd) >= 2
+
+
+@pytest.mark.parametrize("case", [c for c in CASES if np.any(_scatmech_fixes_basis(c))], ids=_ids)
+def test_where_scatmech_fixes_the_exit_basis_its_values_ignore_phi(case):
+    """The basis conversion in ``_reference`` is only a change of basis: at
+    those geometries SCATMECH's matrix equals its own φs = 0 value (same θi),
+    so it is the φs = 0 basis; converted, it rotates with φs.  And the raw
+    matrices differ from ours, so the conversion is needed."""
+    ti, ps = np.array(case["theta_i"]), np.array(case["phi_s"])
+    raw = np.array(case["mueller"])
+    fixed = np.flatnonzero(_scatmech_fixes_basis(case) & (np.abs(np.sin(ps)) > 0.05))
+    assert fixed.size >= 2
+    twins = np.array(case["theta_s"]) == 0.0
+    for k in fixed:
+        twin = np.flatnonzero(twins & (ti == ti[k]) & (ps == 0.0))
+        assert twin.size == 1
+        np.testing.assert_allclose(raw[k], raw[twin[0]], rtol=0, atol=1e-12 * raw[k, 0, 0])
+    ours = _evaluate(case)[fixed]
+    assert np.max(np.abs(ours - raw[fixed]) / raw[fixed, 0, 0, None, None]) > 0.05
+
+
 @pytest.mark.parametrize("case", [c for c in CASES if c["model"] != "smooth_diffuse"], ids=_ids)
 def test_every_element_matches_scatmech(case):
-    ref = np.array(case["mueller"])
+    ref = _reference(case)
     ours = _evaluate(case)
     assert ours.shape == ref.shape
     assert np.max(_relative_error(ours, ref)) < TOL

@@ -58,8 +58,8 @@ SMOOTH_AND_ROUGH = [
 def test_continuous_at_normal_incidence_and_in_plane(fn, kw):
     """s/p bases are undefined at normal incidence and the plane of incidence
     is special at φ = 0, π: values there join their neighbours.  (At θs = 0
-    the polarization basis is fixed to s = ŷ, so only φ = 0 is continuous in
-    the off-diagonal Mueller elements; M00 is continuous for every φ.)"""
+    the exit basis is the limit along φs, so every element is continuous
+    there at every φ: tests/test_normal_basis.py.)"""
     ts, ps = np.array([0.2, 0.9, 0.5, 0.5]), np.array([0.4, 2.5, 0.0, np.pi])
     for dt in (1e-9,):
         a = fn(0.0, ts, ps, **kw)

@@ -20,13 +20,6 @@ from . import _validate, _vectorize, distributions, fresnel, geometry
 _NORMAL_EPS = 1e-12
 
 
-def _basis_azimuth(sin_theta, cos_phi, sin_phi):
-    """cos and sin of the azimuth of the outgoing ray's s/p basis: the ray's
-    own, except s = ŷ (azimuth 0) along the normal (geometry.sp_basis)."""
-    normal = sin_theta < geometry.PARALLEL_EPS
-    return np.where(normal, 1.0, cos_phi), np.where(normal, 0.0, sin_phi)
-
-
 def _rotations(ua, va, ub, vb, fallback_b):
     """Normalize the components (ua, va) of the local s vector in the incoming
     basis and (ub, vb) in the outgoing one; where they vanish use s_loc = s_a,
@@ -90,8 +83,10 @@ def facet_reflection(theta_i, theta_s, phi_s, *, n, slope, distribution="gaussia
         rs, rp = fresnel.reflection_coefficients(cos_iota, n)
         if not want_mueller:
             return scale * 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)
-        cpb, spb = _basis_azimuth(ss, cp, sp)
         # Local s ∝ k_i × k_s; its components in the bases of k_i and k_s.
+        # The outgoing basis has the azimuth φs even at θs = 0: the limit of
+        # s = ẑ×k_s/|ẑ×k_s| along φs, as in SCATMECH (geometry module).
+        cpb, spb = cp, sp
         rot = _rotations(
             -(ci * ss * cpb + si * cs),
             ss * spb,
@@ -142,8 +137,9 @@ def facet_transmission(theta_i, theta_t, phi_t, *, n, slope, distribution="gauss
         t_s, t_p, _ = fresnel.transmission_coefficients(np.clip(cos_ii, 0.0, 1.0), n)
         if not want_mueller:
             return scale * 0.5 * (t_s * t_s + t_p * t_p)
-        cpb, spb = _basis_azimuth(st, cp, sp)
-        # Local s ∝ k_i × k_t; its components in the bases of k_i and k_t.
+        # Local s ∝ k_i × k_t; its components in the bases of k_i and k_t
+        # (azimuth φt even at θt = 0, as in facet_reflection).
+        cpb, spb = cp, sp
         rot = _rotations(
             si * ct - ci * st * cpb,
             st * spb,

@@ -7,10 +7,15 @@ Vectors are numpy arrays whose last axis holds (x, y, z).
   φs = 0 with θs = θi is the specular direction.
 * Transmitted propagation: k_t = (sin θt cos φt, sin θt sin φt, -cos θt), θt from
   the inward normal, φt = 0 the regular refraction side.
-* s/p basis of a ray k: s = ẑ×k / |ẑ×k| (s = ŷ when k ∥ ẑ), p = k×s.  This is
-  SCATMECH's ``GetBasisVectorsSP``; the paper's Eq. 8 uses s = k×n̂, which
-  differs only by the sign of both s and p and leaves every Mueller matrix
-  unchanged.
+* s/p basis of a ray k: s = ẑ×k / |ẑ×k|, p = k×s.  This is SCATMECH's
+  ``GetBasisVectorsSP``; the paper's Eq. 8 uses s = k×n̂, which differs only
+  by the sign of both s and p and leaves every Mueller matrix unchanged.
+  Along the normal (k ∥ ẑ) s is the limit along the ray's azimuth φ,
+  s = (-sin φ, cos φ, 0), as SCATMECH's models take it: the caller's φs (or
+  φt) defines the exit basis at θs = 0, and the incident ray, whose azimuth
+  is fixed at π, has s = ŷ at θi = 0.  ``sp_basis`` sees only k and returns
+  this limit for φ = 0 (s = ŷ); the models build their exit rays at φ = 0 and
+  rotate them, or use the azimuth directly.
 """
 
 from __future__ import annotations
@@ -74,7 +79,7 @@ def unit_or(v: np.ndarray, fallback: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
 def sp_basis(k: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """SCATMECH's s/p basis of propagation direction k: s = ẑ×k/|ẑ×k|
-    (ŷ when k ∥ ẑ), p = k×s."""
+    (ŷ when k ∥ ẑ: the limit along the azimuth 0 or π), p = k×s."""
     zxk = np.stack((-k[..., 1], k[..., 0], np.zeros_like(k[..., 0])), axis=-1)
     s, _ = unit_or(zxk, np.array([0.0, 1.0, 0.0]))
     return s, cross(k, s)

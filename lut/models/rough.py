@@ -9,11 +9,12 @@ for the scattered ray from the slope distribution as seen by that ray
   viewer) the facets it meets have density P(ζ) max(cos ι, 0) sec θn per
   dζx dζy (Eq. 36), normalized exactly (each ray meets one facet; the paper's
   Eq. 37 approximates the normalization by cos θ).  We integrate it with a
-  product Gauss rule: Gauss-Legendre in the radial slope ζ for the measure
-  2πζP(ζ)dζ (``distributions.radial_rule``) times Gauss-Legendre in the facet
-  azimuth over the arc where cos ι > 0.  The rule moves smoothly with the
-  direction, so results are smooth in angle, and it is deterministic, so no
-  seed is needed.
+  product rule: in the radial slope, Gauss rules of the measure 2πζP(ζ)dζ
+  split where facets start to turn away from the ray
+  (``distributions.split_radial_rule``), times the periodic trapezoid rule
+  (full circle) or Gauss-Legendre (the arc where cos ι > 0) in the facet
+  azimuth.  The rule moves smoothly with the direction, so results are
+  smooth in angle, and it is deterministic, so no seed is needed.
 
 * **Diffuse term** (Eq. 21 under a rough interface).  The substrate is
   depolarizing and its emitted radiance is uniform, so the BRDF factors:
@@ -73,9 +74,11 @@ def visible_normals(theta, slope: float, distribution: str, nodes):
     A facet with slope ζ at azimuth φ (from u's azimuth) faces u where
     cos θ + ζ sin θ cos φ > 0, i.e. for every φ while ζ < cot θ and on an arc
     |φ| < arccos(-cot θ / ζ) beyond.  The radial integral is split at
-    ζ = cot θ (``distributions.split_radial_rule``): inside, the azimuth runs
-    over the whole circle (periodic trapezoid rule, spectrally accurate);
-    outside, over the visible arc (Gauss-Legendre).  Each facet's weight is
+    ζ = cot θ, or nearer the middle of the facets when that lies far in the
+    tail (``distributions.split_radial_rule``, which has the Gauss rule of
+    each piece): inside, the azimuth runs over the whole circle (periodic
+    trapezoid rule, spectrally accurate); outside, over the visible arc
+    (Gauss-Legendre).  Each facet's weight is
     its share of the projected area, max(cos ι, 0) sec θn (Eq. 36), and the
     weights are normalized to sum to 1.
 
@@ -99,8 +102,13 @@ def visible_normals(theta, slope: float, distribution: str, nodes):
     half = np.where(clipped, np.arccos(np.clip(ratio, -1.0, 1.0)), np.pi)
     x, w_x = np.polynomial.legendre.leggauss(n_phi)
     trap = (2.0 * np.arange(n_phi) + 1.0) / n_phi - 1.0  # periodic trapezoid on [-1, 1)
-    unit = np.where(clipped[..., None], x, trap)
-    w_unit = np.where(clipped[..., None], w_x, 2.0 / n_phi)
+    # The rule follows the radial piece, not the node's own visibility: the
+    # outer piece can begin before ζ = cot θ (where that lies beyond the
+    # split cap), and its nodes' arcs must shrink continuously from π as θ
+    # grows, so they always use Gauss-Legendre.
+    outer = (np.arange(2 * n_zeta) >= n_zeta)[:, None]
+    unit = np.where(outer, x, trap)
+    w_unit = np.where(outer, w_x, 2.0 / n_phi)
     phi = half[..., None] * unit
     w_phi = half[..., None] * w_unit / (2.0 * np.pi)
     zeta_ = zeta[..., None]
@@ -287,7 +295,8 @@ def _prepare(theta, n, slope, distribution, nodes, entering):
     jones = geometry.interface_jones(
         st["k"], st["k_in"], st["h"], st["t_s"], st["t_p"], geometry.sp_basis(st["k"]), (s_loc, p_int)
     )
-    # At φs = 0 the exit's global basis turns rigidly with the azimuth (θs > 0).
+    # Computed at φs = 0; the exit's global basis turns rigidly with the
+    # azimuth (at θs = 0 as well: s = ŷ is the limit along φs = 0).
     st["J"] = jones if entering else np.swapaxes(jones, -1, -2)
     return st
 
@@ -301,8 +310,6 @@ def _single_sum(ti, ts, ps, n, g, slope, distribution, nodes_in, nodes_out, muel
     exit_ = _prepare(us, n, slope, distribution, nodes_out, entering=False)
     m_in, m_out = entry["w"].shape[-1], exit_["w"].shape[-1]
     lit = (ti < np.pi / 2) & (ts < np.pi / 2)
-    # At θs = 0 the global s/p basis of k_s is ŷ/-x̂ whatever φs: do not rotate it.
-    basis_rot = ts > 0.0
     out = np.zeros(ti.shape + ((4, 4) if mueller else ()))
     chunk = max(1, CHUNK_PAIRS // (m_in * m_out))
     for start in range(0, ti.size, chunk):
@@ -332,18 +339,10 @@ def _single_sum(ti, ts, ps, n, g, slope, distribution, nodes_in, nodes_out, muel
             out[sl] = np.sum(weight * m00, axis=(1, 2))
             continue
         v = np.stack((np.stack((v_ss, v_sp), -1), np.stack((v_ps, v_pp), -1)), -2)
-        bmat = b["J"]
-        # Rotating the exit states by φs leaves B unchanged except at θs = 0,
-        # where the global basis stays fixed while the local one turns.
-        rot = ~basis_rot[sl]
-        if np.any(rot):
-            c1, s1 = cp[rot, :, None, None], sp[rot, :, None, None]
-            r = np.concatenate(
-                (np.concatenate((c1, s1), -1), np.concatenate((-s1, c1), -1)), -2
-            )  # (c, 1, 2, 2): rotation of the s/p components by -φs
-            bmat = bmat.copy()
-            bmat[rot] = np.matmul(r, bmat[rot])
-        jones = np.matmul(np.matmul(bmat[:, None, :, :, :], v), a["J"][:, :, None, :, :])
+        # Rotating the exit states by φs leaves B unchanged: the exit ray's
+        # global basis turns rigidly with them, at θs = 0 too (the limit along
+        # φs, as for every model; docs/models.md, Conventions).
+        jones = np.matmul(np.matmul(b["J"][:, None, :, :, :], v), a["J"][:, :, None, :, :])
         out[sl] = np.sum(weight[..., None, None] * jones_to_mueller(jones), axis=(1, 2))
     out[~lit] = 0.0
     return out.reshape(shape + ((4, 4) if mueller else ()))

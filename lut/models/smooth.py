@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _validate, _vectorize, fresnel, geometry, phase
+from . import _validate, _vectorize, fresnel, phase
 from .mueller import jones_to_mueller
 
 
@@ -99,9 +99,9 @@ def smooth_single(theta_i, theta_s, phi_s, *, n, g, mueller=True):
         cos_sc = np.clip(sin_ip * sin_sp * cp - cos_ip * cos_sp, -1.0, 1.0)
         denom = np.where(ok, cos_i * cos_s * (cos_ip + cos_sp), 1.0)
         scale = np.where(ok, phase.rayleigh_factor(cos_sc, g) * cos_ip * cos_sp / denom, 0.0)
-        # V in the internal s/p bases (s = ŷ for the exit ray along the normal).
-        normal = sin_sp < geometry.PARALLEL_EPS
-        cb, sb = np.where(normal, 1.0, cp), np.where(normal, 0.0, sp)
+        # V in the internal s/p bases; the exit basis has the azimuth φs even
+        # at θs = 0 (the limit along φs; docs/models.md, Conventions).
+        cb, sb = cp, sp
         v_ss, v_sp = cb, -sb * cos_ip
         v_ps, v_pp = -sb * cos_sp, sin_ip * sin_sp - cos_ip * cos_sp * cb
         if not want_mueller:
