@@ -3,6 +3,8 @@ settings, presets, live colours, stale tracking, baking paint types and the
 node groups."""
 
 import json
+import os
+import pathlib
 
 import numpy as np
 import pytest
@@ -420,3 +422,17 @@ def test_a_type_edited_during_a_background_bake_stays_stale(material, tmp_path):
         material, api.paint_of(material), job.result, settings.type_key()
     )
     assert not settings.stale
+
+
+def test_an_unsaved_file_bakes_into_a_folder_of_this_user(fresh_file):
+    """Not a shared temporary folder that another user may own: the
+    extension's user folder, or (outside an extension) a per-user one."""
+    import getpass
+    import tempfile
+
+    from addon import api
+
+    folder = api.lut_directory()
+    assert folder.is_dir() and os.access(folder, os.W_OK)
+    assert folder != pathlib.Path(tempfile.gettempdir()) / "paint_lut"
+    assert getpass.getuser() in str(folder) or "extensions" in str(folder)

@@ -54,11 +54,14 @@ def lut_bytes(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def weights_bytes(tmp_path_factory):
+    """A closure fit's weights file, as the render path writes it."""
+    from lut import fitting
+
     directory = tmp_path_factory.mktemp("fuzz_weights")
-    pixels = np.random.default_rng(SEED).uniform(0.0, 2.0, (5, 17, 3)).astype(np.float32)
-    attrs = {"paintlut:closures": "('lambert', 'toon 0.2', 'metallic 0.1')"}
-    path = lutfile.write_exr(directory / "weights.exr", pixels, attrs)
-    return path.read_bytes(), pixels
+    table = lut.load_lut(lut.bake(lut.Paint(rho=0.4, slope=0.3), directory, resolution=RESOLUTION))
+    fit = fitting.fit_lut(table, "CYCLES", budget=3)
+    path = fitting.write_fit(fit, directory / "weights.exr")
+    return path.read_bytes(), fitting.read_fit(path)
 
 
 def _damaged(data: bytes, rng: random.Random):
@@ -96,19 +99,24 @@ def test_damaged_luts_load_identical_data_or_raise_lut_error(reader, lut_bytes, 
 
 
 def test_damaged_weights_load_identical_data_or_raise_lut_error(reader, weights_bytes, tmp_path):
-    data, pixels = weights_bytes  # ZIP-compressed when OpenImageIO wrote it: the fallback reads that too
+    from lut import fitting
+
+    data, fit = weights_bytes  # ZIP-compressed when OpenImageIO wrote it: the fallback reads that too
     target = tmp_path / "paintfit-damaged.exr"
     rng = random.Random(SEED + 1)
+    refused = 0
     for what, damaged in _damaged(data, rng):
         target.write_bytes(damaged)
         try:
-            loaded = lutfile.read_exr(target)
+            loaded = fitting.read_fit(target)
         except lut.LUTError as exc:
             assert str(target) in str(exc), what
+            refused += 1
             continue
-        except Exception as exc:
+        except Exception as exc:  # the defect this test exists for
             pytest.fail(f"{what}: {type(exc).__name__}: {exc}")
-        assert np.array_equal(loaded, pixels), what
+        assert np.array_equal(loaded.weights, fit.weights) and loaded.header() == fit.header(), what
+    assert refused > FLIPS // 2
 
 
 def test_a_weights_file_without_its_hash_is_refused(tmp_path, reader):
@@ -129,3 +137,12 @@ def test_bake_rebakes_a_lut_whose_metadata_is_not_utf8(reader, tmp_path):
         lut.load_lut(path)
     assert lut.bake(paint, tmp_path, resolution=RESOLUTION) == path
     assert lut.load_lut(path).matches(paint)  # baked again, whole
+
+
+def test_a_weights_file_of_the_previous_release_is_refused_not_misread(tmp_path, reader):
+    from lut import fitting
+
+    path = tmp_path / "paintfit-old.exr"
+    lutfile.write_exr(path, np.ones((2, 3, 3), np.float32), {"paintlut:closures": "('lambert',)"})
+    with pytest.raises(lut.LUTError, match="not a Paint LUT weights file"):
+        fitting.read_fit(path)
