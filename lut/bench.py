@@ -63,7 +63,7 @@ def throughput(count=100_000, grid=False):
 
 
 def table_angles(shape=(64, 64, 32)):
-    """The (θi, θs, φs) table of the issue: midpoints in θ ∈ [0, π/2), φ ∈ [0, π]."""
+    """The benchmark's (θi, θs, φs) table: midpoints in θ ∈ [0, π/2), φ ∈ [0, π]."""
     ti = (np.arange(shape[0]) + 0.5) / shape[0] * np.pi / 2
     ts = (np.arange(shape[1]) + 0.5) / shape[1] * np.pi / 2
     ps = np.linspace(0.0, np.pi, shape[2])

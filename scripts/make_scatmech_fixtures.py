@@ -8,8 +8,8 @@ Needs NIST SCATMECH's Python binding, which is *not* a project dependency
 
 Each case records the model, its parameters, the geometry (radians) and the
 Mueller BRDF returned by ``BRDF_Model.MuellerBRDF(thetai, thetas, phis, 0,
-"psps")``, with the model parameters of the issue that introduced the
-fixtures (lambda 0.532, substrate (n,0), No_StackModel).
+"psps")``, with the fixtures' model parameters (lambda 0.532, substrate
+(n,0), No_StackModel).
 """
 
 from __future__ import annotations
