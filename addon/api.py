@@ -13,11 +13,8 @@ import pathlib
 
 import bpy
 
-import lut
-import lut.fitting
-from lut import closures, render
-
 from . import nodes, properties, validation
+from ._lut import closures, lut, render
 from .properties import working_space
 
 #: LUTs go here, relative to the saved .blend file.

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import json
 
-from lut import principled
+from ._lut import principled
 
 #: Names of the fallback's nodes in a material's node tree.
 NODE = "Paint LUT Principled"

@@ -29,7 +29,7 @@ import pathlib
 
 import bpy
 
-from lut import closures, fitting, lutfile
+from ._lut import closures, fitting, lutfile
 
 GROUP_PREFIX = "Paint LUT"
 INPUTS = ("Pigment Color", "Single Scattering Color", "Surface Reflection")
