@@ -2,9 +2,10 @@
 model of lut.principled is Cycles' Principled BSDF, and the fitted fallback
 of a material, as rendered, has the error the fit reports and beats the
 Principled an artist would set up; the fallback leaves what Cycles and
-EEVEE render of the paint unchanged and is what glTF exports."""
+EEVEE render of the paint unchanged and is what glTF and USD export."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -83,7 +84,7 @@ def test_fallback_changes_no_engine_render_and_is_exported(oracle, lut_dir, tmp_
 
     material = oracle.material("paint")
     api.set_paint(material, lut.preset("glossy_white"))
-    api.bake_material(material, directory=lut_dir)
+    api.bake_material(material, directory=lut_dir, resolution=(8, 6, 4))  # a small LUT: only the wiring matters
     geometry = (0.5, 0.7, 1.2)
     before = {}
     for engine in ("CYCLES", EEVEE):
@@ -99,7 +100,7 @@ def test_fallback_changes_no_engine_render_and_is_exported(oracle, lut_dir, tmp_
     outputs = {nd.name: nd for nd in material.node_tree.nodes if nd.type == "OUTPUT_MATERIAL"}
     assert outputs[export.OUTPUT].is_active_output and outputs[export.OUTPUT].target == "ALL"
     # Re-baking rewires the engine outputs; refreshing the fallback restores it.
-    api.bake_material(material, directory=lut_dir)
+    api.bake_material(material, directory=lut_dir, resolution=(8, 6, 4))  # a small LUT: only the wiring matters
     export.update_fallback(material)
     assert [nd.target for nd in material.node_tree.nodes if nd.type == "OUTPUT_MATERIAL"].count("ALL") == 1
 
@@ -111,3 +112,14 @@ def test_fallback_changes_no_engine_render_and_is_exported(oracle, lut_dir, tmp_
     assert pbr["roughnessFactor"] == pytest.approx(params.roughness, abs=1e-6)
     assert pbr.get("metallicFactor", 1.0) == 0.0
     assert export.fallback_params(material)[0] == params
+
+    # USD's exporter reads the same node (UsdPreviewSurface).
+    usd = tmp_path / "paint.usda"
+    assert bpy.ops.wm.usd_export(filepath=str(usd)) == {"FINISHED"}
+    text = usd.read_text()
+    colour = re.search(r"color3f inputs:diffuseColor = \(([^)]*)\)", text).group(1)
+    np.testing.assert_allclose([float(v) for v in colour.split(",")], params.base_color, atol=1e-6)
+    assert float(re.search(r"float inputs:roughness = (\S+)", text).group(1)) == pytest.approx(
+        params.roughness, abs=1e-6
+    )
+    assert float(re.search(r"float inputs:ior = (\S+)", text).group(1)) == pytest.approx(params.ior, abs=1e-5)
