@@ -8,16 +8,14 @@ is all a colour edit needs."""
 
 from __future__ import annotations
 
+import functools
 import json
 import pathlib
 
 import bpy
 
-import lut
-import lut.fitting
-from lut import closures, render
-
-from . import nodes, properties, validation
+from . import export, nodes, properties, validation
+from ._lut import closures, lut, render
 from .properties import working_space
 
 #: LUTs go here, relative to the saved .blend file.
@@ -87,6 +85,7 @@ def store_result(material, paint: lut.Paint, result: render.RenderBake, exact_me
         {target: {"residual": f.residual.tolist(), "reference": f.reference.tolist(), "goal": f.target_error}
          for target, f in result.fits.items()}
     )  # fmt: skip
+    export.update_fallback(material, paint)
     if clear_stale:
         settings.stale = False
 
@@ -131,7 +130,27 @@ def update_inputs(material) -> None:
     except ValueError:
         return
     rbar = settings.internal_reflectance if settings.internal_reflectance > 0 else None
-    nodes.set_inputs(material, render.node_inputs(paint, rbar))
+    values = render.node_inputs(paint, rbar)
+    nodes.set_inputs(material, values)
+    if rbar is not None and settings.lut_path and not settings.stale:
+        try:  # the export fallback follows the colour too (its shape waits for the next bake)
+            table = _loaded_lut(bpy.path.abspath(settings.lut_path))
+            export.recolour_fallback(material, table, render.amplitudes_of_inputs(values, rbar))
+        except lut.LUTError:
+            pass  # no LUT to refit from: the fallback keeps its colour until the next bake
+
+
+@functools.lru_cache(maxsize=8)
+def _loaded_lut_at(path, mtime_ns):
+    return lut.load_lut(path)
+
+
+def _loaded_lut(path):
+    """A LUT read once per file version (colour edits come in bursts)."""
+    try:
+        return _loaded_lut_at(str(path), pathlib.Path(path).stat().st_mtime_ns)
+    except OSError as exc:
+        raise lut.LUTError(f"{path}: {exc}") from None
 
 
 def fit_errors(material) -> dict:

@@ -29,10 +29,8 @@ import pathlib
 
 import bpy
 
-import lut
-from lut import closures, fitting, lutfile
-
 from . import api, nodes
+from ._lut import closures, fitting, lut, lutfile
 
 #: The first bytes of a .blend file: plain, gzip (Blender < 3) or zstd compressed.
 _MAGIC = (b"BLENDER", b"\x1f\x8b", b"\x28\xb5\x2f\xfd")

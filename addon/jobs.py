@@ -7,8 +7,7 @@ from __future__ import annotations
 
 import threading
 
-import lut
-from lut import closures, render
+from ._lut import closures, lut, render
 
 
 class Cancelled(Exception):

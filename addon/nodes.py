@@ -29,9 +29,12 @@ import pathlib
 
 import bpy
 
-from lut import closures, fitting, lutfile
+from ._lut import closures, fitting, lutfile
 
 GROUP_PREFIX = "Paint LUT"
+#: The Material Output of the Principled fallback for exporters (addon.export):
+#: targeted at all engines and kept so.
+EXPORT_OUTPUT = "Paint LUT Export Output"
 INPUTS = ("Pigment Color", "Single Scattering Color", "Surface Reflection")
 
 #: The Metallic BSDF's physical conductor Fresnel is the exact dielectric
@@ -507,7 +510,7 @@ def wire(material, groups, values=None):
     if material.node_tree is None:  # Blender 4.x: a new material has no node tree yet
         material.use_nodes = True
     nodes, links = material.node_tree.nodes, material.node_tree.links
-    outputs = [nd for nd in nodes if nd.type == "OUTPUT_MATERIAL"]
+    outputs = [nd for nd in nodes if nd.type == "OUTPUT_MATERIAL" and nd.name != EXPORT_OUTPUT]
     for nd in outputs:
         if nd.target == "ALL":
             nd.target = "CYCLES"

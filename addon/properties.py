@@ -15,9 +15,7 @@ import json
 
 import bpy
 
-import lut
-import lut.models
-import lut.render
+from ._lut import lut
 
 PRESET_ITEMS = [
     ("CUSTOM", "Custom", "Paint given by the fields below"),

@@ -12,9 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
-import lut
-
 from . import properties
+from ._lut import lut
 
 #: Panel fields checked against their property's hard limits.
 _SCALARS = ("n", "g", "slope", "facet")

@@ -20,7 +20,7 @@ import sys
 import time
 import tomllib
 
-from . import __version__, baking, cleanup, colour_management, examples, figures, lutfile, presets, render, table
+from . import __version__, baking, cleanup, colour_management, lutfile, presets, render, table
 from .baking import BAKE_SINGLE_NODES
 from .models.rough import DIFFUSE_NODES
 from .paint import Paint
@@ -216,6 +216,12 @@ def _cmd_clean(args) -> int:
 
 
 def _cmd_example(args) -> int:
+    try:  # development modules: the extension's wheel leaves them out
+        from . import examples, figures
+    except ImportError as error:
+        raise SystemExit(
+            f"error: the example command needs the repository's lut (examples, figures): {error}"
+        ) from None
     _check_sizes(args)
     out = pathlib.Path(args.out)
     data = examples.fig2_glossy_white(theta_s_deg=[-60, -30, 0, 30, 60, 80])

@@ -4,9 +4,12 @@
 
 The zip holds the add-on (addon/*.py, relative imports) with the repository's
 blender_manifest.toml, and the library as a wheel of its own
-(wheels/paint_lut-<version>-py3-none-any.whl, package ``lut``): Blender
-installs bundled wheels into the extensions' shared site-packages, so the
-installed add-on imports ``lut`` exactly as the repository's tests do.
+(wheels/paint_lut-<version>-py3-none-any.whl).  Blender installs bundled
+wheels into the extensions' shared site-packages, where another extension's
+top-level ``lut`` could clash with ours, so the wheel's package is the
+repository's ``lut`` renamed ``paint_lut_core`` (its imports are relative);
+the add-on imports it through addon/_lut.py.  The development-only modules
+(``DEV_ONLY``: plots and benchmarks) are left out.
 
 The one wheel is pure Python and serves Linux, Windows and macOS alike: at run
 time lut needs only numpy and OpenImageIO, which Blender 5.0 ships, and its
@@ -33,6 +36,13 @@ import zipfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+
+#: The library's package name inside the wheel (addon/_lut.py imports it).
+PACKAGE = "paint_lut_core"
+
+#: lut modules the wheel leaves out: matplotlib plots (figures, and examples,
+#: which draws them) and benchmarks; the CLI's ``example`` command says so.
+DEV_ONLY = ("bench.py", "examples.py", "figures.py")
 
 #: zip entries get this fixed time, so the same sources give the same wheel.
 EPOCH = (1980, 1, 1, 0, 0, 0)
@@ -74,12 +84,18 @@ def _add(archive: zipfile.ZipFile, name: str, data: bytes, record: list) -> None
 
 
 def build_wheel(directory: pathlib.Path) -> pathlib.Path:
-    """Write the pure-Python wheel of ``lut`` (PEP 427) into ``directory``."""
+    """Write the pure-Python wheel of ``lut`` as ``PACKAGE`` (PEP 427),
+    without ``DEV_ONLY``, into ``directory``."""
     meta = project()
     dist_info = f"{meta['name'].replace('-', '_')}-{meta['version']}.dist-info"
     path = directory / wheel_name()
     record: list[str] = []
-    sources = sorted(p for p in (ROOT / "lut").rglob("*.py") if "__pycache__" not in p.parts)
+    library = ROOT / "lut"
+    sources = sorted(
+        p
+        for p in library.rglob("*.py")
+        if "__pycache__" not in p.parts and p.relative_to(library).as_posix() not in DEV_ONLY
+    )
     metadata = [
         "Metadata-Version: 2.1",
         f"Name: {meta['name']}",
@@ -93,7 +109,7 @@ def build_wheel(directory: pathlib.Path) -> pathlib.Path:
     wheel.append("Tag: py3-none-any")
     with zipfile.ZipFile(path, "w") as archive:
         for source in sources:
-            _add(archive, source.relative_to(ROOT).as_posix(), source.read_bytes(), record)
+            _add(archive, f"{PACKAGE}/{source.relative_to(library).as_posix()}", source.read_bytes(), record)
         _add(archive, f"{dist_info}/METADATA", ("\n".join(metadata) + "\n").encode(), record)
         _add(archive, f"{dist_info}/WHEEL", ("\n".join(wheel) + "\n").encode(), record)
         record.append(f"{dist_info}/RECORD,,")

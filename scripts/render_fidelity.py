@@ -32,14 +32,15 @@ import addon  # noqa: E402
 from lut import bench, lutfile  # noqa: E402
 
 
-def measure(paint, directory, eevee=True, lobes_4x=True, baseline=True):
+def measure(paint, directory, eevee=True, lobes_4x=True, baseline=True, cycles=True):
     row = {"rough": paint.slope > 0}
     oracle = Oracle()
     _, result = paint_material(oracle, paint, directory)
-    row["cycles"] = relative_rms(oracle, paint, GRID)
     row["cycles_fit"] = result.errors(paint)["CYCLES"]
     row["eevee_fit"] = result.errors(paint)["EEVEE"]
-    if lobes_4x and paint.slope > 0:  # Blender 4.2-4.5's facet lobes (Principled, GGX), in 5.x's Cycles
+    if cycles:
+        row["cycles"] = relative_rms(oracle, paint, GRID)
+    if lobes_4x and cycles and paint.slope > 0:  # Blender 4.2-4.5's facet lobes (Principled, GGX), in 5.x's Cycles
         oracle = Oracle()
         paint_material(oracle, paint, directory, exact_metallic=False)
         row["cycles_4x"] = relative_rms(oracle, paint, GRID)
@@ -47,7 +48,7 @@ def measure(paint, directory, eevee=True, lobes_4x=True, baseline=True):
         oracle = Oracle(engine=EEVEE)
         paint_material(oracle, paint, directory)
         row["eevee"] = relative_rms(oracle, paint, GRID_EEVEE)
-    if baseline:
+    if baseline and cycles:
         oracle = Oracle()
         principled(oracle, paint)
         row["principled"] = relative_rms(oracle, paint, GRID, best_scale=True)
@@ -65,26 +66,35 @@ def main(argv=None) -> int:
     parser.add_argument("--random", type=int, default=24, help="paints of the randomised set (lut.bench.random_paints)")
     parser.add_argument("--eevee-random", type=int, default=6, help="of those, how many to render in EEVEE too")
     parser.add_argument("--seed", type=int, default=2026)
+    parser.add_argument("--no-eevee", action="store_true", help="Cycles and the baseline only (EEVEE renders are slow)")
+    parser.add_argument("--only-eevee", action="store_true", help="EEVEE only, for the named paints and --eevee-random")
     args = parser.parse_args(argv)
     addon.register()
     rows = {}
     with tempfile.TemporaryDirectory() as tmp:
+        cycles, eevee = not args.only_eevee, not args.no_eevee
         for name, paint in paints().items():
-            rows[name] = measure(paint, pathlib.Path(tmp))
+            rows[name] = measure(paint, pathlib.Path(tmp), eevee=eevee, cycles=cycles)
             print(name, {k: (round(v, 4) if isinstance(v, float) else v) for k, v in rows[name].items()}, flush=True)
         for i, (label, paint) in enumerate(bench.random_paints(args.random, args.seed)):
-            rows[label] = measure(paint, pathlib.Path(tmp), eevee=i < args.eevee_random, baseline=False)
+            if args.only_eevee and i >= args.eevee_random:
+                break
+            rows[label] = measure(
+                paint, pathlib.Path(tmp), eevee=eevee and i < args.eevee_random, cycles=cycles, baseline=False
+            )
             rows[label]["random"] = True
             print(label, {k: (round(v, 4) if isinstance(v, float) else v) for k, v in rows[label].items()}, flush=True)
     lutfile.atomic_write_bytes(args.out, (json.dumps(rows, indent=2) + "\n").encode())
+    if args.only_eevee or args.no_eevee:
+        print("(a partial run: merge it with the other into the README's table by hand)")
     print("| paint | Cycles (fit reports) | Cycles, 4.2-4.5 lobes | EEVEE | Principled BSDF: best scale (as is) |")
     print("|---|---|---|---|---|")
     for name, r in rows.items():
         if r.get("random"):
             continue
-        base = f"{r['principled']:.1%} ({r['principled_unscaled']:.1%})"
+        base = f"{r['principled']:.1%} ({r['principled_unscaled']:.1%})" if "principled" in r else ""
         print(
-            f"| {name} | {_pct(r['cycles'])} ({_pct(r['cycles_fit'])}) | {_pct(r.get('cycles_4x')) or 'same'} "
+            f"| {name} | {_pct(r.get('cycles'))} ({_pct(r['cycles_fit'])}) | {_pct(r.get('cycles_4x')) or 'same'} "
             f"| {_pct(r.get('eevee'))} | {base} |"
         )
     print("\nRandomised set (worst / median):")

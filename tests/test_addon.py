@@ -148,6 +148,9 @@ def test_glossy_black_bakes_and_renders_only_its_mirror(material, lut_dir):
     api.set_paint(material, lut.Paint(rho=0.0))
     api.bake_material(material, directory=lut_dir, **SMALL)
     assert _inputs(material)["Pigment Color"] == pytest.approx((0.0, 0.0, 0.0))
+    fallback = material.node_tree.nodes["Paint LUT Principled"]  # for export: a black dielectric mirror
+    assert tuple(fallback.inputs["Base Color"].default_value)[:3] == (0.0, 0.0, 0.0)
+    assert fallback.inputs["Roughness"].default_value == 0.0
     group = _group_node(material).node_tree
     assert any(nd.type == "BSDF_METALLIC" and nd.label.startswith("Mirror") for nd in group.nodes)
 
@@ -215,7 +218,10 @@ def test_bake_wires_a_group_per_engine_with_colour_inputs(material, lut_dir):
     tree.links.new(texture.outputs["Color"], _group_node(material).inputs["Pigment Color"])
     material.paint_lut.g = 0.3
     api.bake_material(material, directory=lut_dir, **SMALL)
-    assert sum(nd.type == "OUTPUT_MATERIAL" for nd in tree.nodes) == 2
+    outputs = {nd.target for nd in tree.nodes if nd.type == "OUTPUT_MATERIAL" and nd.name != nodes.EXPORT_OUTPUT}
+    assert outputs == {"CYCLES", "EEVEE"} and sum(nd.type == "OUTPUT_MATERIAL" for nd in tree.nodes) == 3
+    export_output = tree.nodes[nodes.EXPORT_OUTPUT]  # the Principled fallback, for exporters
+    assert export_output.target == "ALL" and export_output.is_active_output
     assert sum(nd.type == "GROUP" for nd in tree.nodes) == 2
     assert _group_node(material).inputs["Pigment Color"].links[0].from_node == texture
     rough = bpy.data.materials.new("rough")
@@ -436,3 +442,18 @@ def test_an_unsaved_file_bakes_into_a_folder_of_this_user(fresh_file):
     assert folder.is_dir() and os.access(folder, os.W_OK)
     assert folder != pathlib.Path(tempfile.gettempdir()) / "paint_lut"
     assert getpass.getuser() in str(folder) or "extensions" in str(folder)
+
+
+def test_the_export_fallback_follows_colour_edits(material, lut_dir):
+    """After a bake the Principled fallback is fitted; a colour edit solves
+    its base colour again at once (its shape waits for the next bake)."""
+    from addon import api, export
+
+    api.set_paint(material, lut.Paint(rho=(0.7, 0.3, 0.1), slope=0.2))
+    api.bake_material(material, directory=lut_dir, **SMALL)
+    before, _ = export.fallback_params(material)
+    material.paint_lut.rho = (0.1, 0.3, 0.7)
+    after, error = export.fallback_params(material)
+    assert after.roughness == before.roughness and after.ior == before.ior
+    assert after.base_color[2] > after.base_color[0] and before.base_color[0] > before.base_color[2]
+    assert error is not None and error < 0.1

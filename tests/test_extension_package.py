@@ -29,14 +29,49 @@ def test_zip_holds_the_add_on_manifest_and_lut_wheel(package):
         names = set(archive.namelist())
         manifest = tomllib.loads(archive.read("blender_manifest.toml").decode())
         wheel = manifest["wheels"][0].removeprefix("./")
+        # The one permission says what is written, where, and why.
+        assert ".blend" in manifest["permissions"]["files"] and "reuse" in manifest["permissions"]["files"]
         assert {"__init__.py", "api.py", "nodes.py", "properties.py", wheel} <= names
         assert not any(name.startswith(("lut/", "tests/", "scripts/")) or "__pycache__" in name for name in names)
         with zipfile.ZipFile(archive.open(wheel)) as inner:
             files = set(inner.namelist())
-    assert {"lut/__init__.py", "lut/colour_data.py", "lut/models/rough.py"} <= files
-    assert not any(f.startswith(("addon/", "tests/")) for f in files)
+    package = build_extension.PACKAGE
+    assert {f"{package}/__init__.py", f"{package}/colour_data.py", f"{package}/models/rough.py"} <= files
+    assert f"{package}/principled.py" in files
+    assert not any(f.startswith(("lut/", "addon/", "tests/")) for f in files)
     record = next(f for f in files if f.endswith(".dist-info/RECORD"))
     assert record.startswith("paint_lut-0.1.0.dist-info/")
+
+
+def test_wheel_leaves_out_development_modules_and_still_imports(tmp_path):
+    """No plots or benchmarks in the wheel, and what is left imports without
+    them: the package, its CLI module (whose example command needs them) and
+    everything the add-on uses."""
+    wheel = build_extension.build_wheel(tmp_path)
+    package = build_extension.PACKAGE
+    with zipfile.ZipFile(wheel) as inner:
+        files = set(inner.namelist())
+        inner.extractall(tmp_path / "site")
+    for module in ("figures.py", "bench.py", "examples.py"):
+        assert f"{package}/{module}" not in files
+    code = textwrap.dedent(
+        f"""
+        import importlib, sys
+        sys.modules["matplotlib"] = None  # no matplotlib either
+        for name in ("", ".__main__", ".principled", ".render", ".fitting", ".lutfile", ".exr"):
+            importlib.import_module("{package}" + name)
+        from {package} import __main__ as cli
+        try:
+            cli.main(["example", "--out", {str(tmp_path / "out")!r}])
+        except SystemExit as exit:
+            print("EXIT", exit.code)
+        """
+    )
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    env["PYTHONPATH"] = str(tmp_path / "site")
+    done = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr[-3000:]
+    assert "EXIT error: the example command needs the repository's lut" in done.stdout
 
 
 def test_wheel_is_reproducible(tmp_path):
@@ -74,6 +109,7 @@ def test_manifest_and_versions_agree():
 INSTALLED = textwrap.dedent(
     """
     import importlib, math, sys
+    sys.path.insert(0, {foreign!r})  # another extension's top-level lut
     sys.path.insert(0, {tests!r})
     from blender_oracle import Oracle  # test harness only; not the add-on
     oracle = Oracle()  # factory settings first: they would reset the preferences
@@ -82,8 +118,13 @@ INSTALLED = textwrap.dedent(
         filepath={zip!r}, repo="user_default", enable_on_install=True
     )
     assert result == {{"FINISHED"}}, result
-    import lut
+    import lut as foreign
+    assert foreign.FOREIGN, "the foreign lut is first on sys.path"
+    import paint_lut_core as lut
     api = importlib.import_module("bl_ext.user_default.paint_lut.api")
+    seam = importlib.import_module("bl_ext.user_default.paint_lut._lut")
+    print("SEAM_FROM", seam.lut.__file__)
+    print("API_LUT", api.lut.__name__)
     material = bpy.data.materials.new("paint")
     material.paint_lut.preset = "glossy_red"
     material.paint_lut.enabled = True
@@ -104,7 +145,12 @@ INSTALLED = textwrap.dedent(
 
 def test_installs_offline_into_a_clean_user_directory_and_renders(package, tmp_path):
     resources = tmp_path / "blender_user"
-    code = INSTALLED.format(tests=str(ROOT / "tests"), zip=str(package), blend=str(tmp_path / "scene.blend"))
+    foreign = tmp_path / "foreign"
+    (foreign / "lut").mkdir(parents=True)
+    (foreign / "lut" / "__init__.py").write_text("FOREIGN = True\n")
+    code = INSTALLED.format(
+        tests=str(ROOT / "tests"), foreign=str(foreign), zip=str(package), blend=str(tmp_path / "scene.blend")
+    )
     env = {k: v for k, v in os.environ.items() if k not in {"PYTHONPATH", "BLENDER_USER_SCRIPTS"}}
     env.update(
         BLENDER_USER_RESOURCES=str(resources),
@@ -121,6 +167,8 @@ def test_installs_offline_into_a_clean_user_directory_and_renders(package, tmp_p
         line.split(" ", 1) for line in done.stdout.splitlines() if line.split(" ", 1)[0].isupper() and " " in line
     )
     assert pathlib.Path(out["LUT_FROM"]).is_relative_to(resources)
+    assert out["SEAM_FROM"] == out["LUT_FROM"]
+    assert out["API_LUT"] == "paint_lut_core"
     assert pathlib.Path(out["ADDON_FROM"]).is_relative_to(resources / "extensions" / "user_default" / "paint_lut")
     assert out["LUT_PATH"].startswith("//paint_lut/")
     assert (tmp_path / out["LUT_PATH"][2:]).exists()

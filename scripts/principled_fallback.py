@@ -1,0 +1,64 @@
+"""The Principled fallback's fidelity: per paint, the fitted Principled BSDF
+(lut.principled.fit_principled, as addon.export adds it) rendered by Cycles
+against the model, beside the Principled an artist would set up (ρ as base
+colour, IOR n, roughness sqrt(slope), Blender's default multiscatter GGX).
+
+    .venv/bin/python scripts/principled_fallback.py [--out FILE.json]
+
+The measure is the acceptance measure (tests/blender_oracle.py): the
+cos-weighted relative RMS of f·cos θl against Paint.brdf · cos θl for
+θl, θv <= 75° away from the mirror direction."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+
+import bpy  # noqa: E402,F401
+from blender_oracle import Oracle, paints, principled, relative_rms  # noqa: E402
+
+from lut import principled as fallback  # noqa: E402
+
+
+def fallback_material(oracle, params):
+    """The fallback's Principled BSDF on the oracle's plane."""
+    mat = oracle.material("fallback")
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    bsdf = nodes.new("ShaderNodeBsdfPrincipled")
+    bsdf.distribution = "GGX"
+    for name, value in params.node_inputs().items():
+        bsdf.inputs[name].default_value = value
+    links.new(bsdf.outputs[0], nodes["Material Output"].inputs["Surface"])
+    return mat
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", help="also write the figures as JSON")
+    args = parser.parse_args(argv)
+    oracle = Oracle()
+    rows = {}
+    print(f"{'paint':16} {'fit':>7} {'Cycles':>7} {'artist':>7}  parameters")
+    for name, paint in paints().items():
+        params, error = fallback.fit_principled(paint)
+        fallback_material(oracle, params)
+        rendered = relative_rms(oracle, paint)
+        principled(oracle, paint)
+        artist = relative_rms(oracle, paint)
+        rows[name] = {"fit": error, "rendered": rendered, "artist": artist, "params": params.to_dict()}
+        print(f"{name:16} {error:7.4f} {rendered:7.4f} {artist:7.4f}  {params}")
+    if args.out:
+        from lut.lutfile import atomic_target
+
+        with atomic_target(args.out) as tmp:
+            pathlib.Path(tmp).write_text(json.dumps(rows, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
