@@ -1,5 +1,5 @@
 """Measure how EEVEE renders the closures a Paint LUT fit may use, and write
-the tables ``lut.eevee`` interpolates (``lut/eevee_tables.npz``).
+the tables ``lut.eevee`` interpolates (``lut/eevee_tables.py``).
 
 Method.  A grid of spheres (one closure each, white, unit weight) under a
 delta Sun (angle 0, no shadows) in a black world, seen by an orthographic
