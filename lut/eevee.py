@@ -48,6 +48,17 @@ IORS = (1.33, 1.5, 1.7, 2.0)
 #: Kinds with tables (the closure kinds an EEVEE fit may use).
 KINDS = ("lambert", "oren_nayar", "sheen", "retro_toon", "glossy", "metallic")
 
+#: What EEVEE (Blender 5.0, one sample per pixel) sums exactly, measured by
+#: scripts/eevee_additivity.py: diffuse closures sharing the surface normal
+#: (measured with two Lambert closures: merged into one), plus at most two
+#: reflection closures (Glossy, Metallic, any roughness).  Beyond
+#: that, or with diffuse closures of different normals (a retro Toon next to
+#: a Lambert), EEVEE picks closures at random per pixel, weighted so the mean
+#: stays right: the sum is noisy (pixel spread 7-90%) until many samples
+#: average it.
+EXACT_DIFFUSE_NORMALS = 1
+EXACT_REFLECTION_CLOSURES = 2
+
 
 def table_key(closure: Closure) -> str:
     """The table of a calibrated closure: its kind and the parameters EEVEE's

@@ -56,6 +56,10 @@ CASES = {
     "all 7 but retro": [0, 2, 3, 4, 5, 6, 7],
     "retro + Glossy": [1, 3],
     "retro + 2 Lambert": [1, 0, 6],
+    "3 reflection": [3, 4, 2],
+    "4 reflection": [3, 4, 2, 5],
+    "Lambert + 3 reflection": [0, 3, 4, 2],
+    "2 Lambert + 2 reflection": [0, 6, 3, 2],
 }
 GAMMAS = (0.0, 30.0, 60.0)
 

@@ -92,9 +92,9 @@ def fit_with(table, basis, evaluate, target="EEVEE", budget=None):
     )
 
 
-def _grams(table, basis, cos_view, weights, evaluate):
-    """``fitting._acceptance_grams`` with the closures evaluated by ``evaluate``."""
-    tl, tv, ph = (a.ravel() for a in np.meshgrid(*fitting.ACCEPTANCE_GRID, indexing="ij"))
+def _grams(table, basis, cos_view, weights, evaluate, grid=fitting.ACCEPTANCE_GRID):
+    """``fitting._acceptance_grams`` with the closures evaluated by ``evaluate``, on ``grid``."""
+    tl, tv, ph = (a.ravel() for a in np.meshgrid(*grid, indexing="ij"))
     cos_l = np.cos(tl)
     target = table.components(tl, tv, ph) * cos_l[:, None, None]
     values = np.stack([evaluate(c, tl, tv, ph) for c in basis], axis=0)
@@ -142,8 +142,9 @@ def main(argv=None):
             "calibrated + retro Toon": fit_with(table, basis + [Closure("retro_toon", 0.3, 0.2)], calibrated),
         }
         for i, (label, fit) in enumerate(variants.items()):
-            # The error each fit should have in EEVEE if its closures render as measured.
-            res, ref = _grams(table, fit.closures, fit.cos_view, fit.weights, calibrated)
+            # The error each fit should have in EEVEE if its closures render as
+            # measured, on the rendered grid.
+            res, ref = _grams(table, fit.closures, fit.cos_view, fit.weights, calibrated, GRID_EEVEE)
             predicted = fitting.acceptance_error(res, ref, amps)
             got = rendered_error(oracle, paint, fit, directory / f"fit-{i}-{table.key[:8]}.exr", f"{name} {i}")
             kinds = ", ".join(f"{c.kind}" + (f" r{c.roughness:g}" if c.kind in ("glossy", "metallic") else "")
