@@ -1,0 +1,258 @@
+"""The closures as EEVEE renders them (numpy only): measured tables, by
+Blender line.
+
+EEVEE does not evaluate closures with Cycles' formulas (``lut.closures``).
+``scripts/calibrate_eevee.py`` renders each closure kind an EEVEE fit may use
+on spheres under a delta Sun and stores, per closure and Blender line, the
+ratio of EEVEE's radiance to a smooth analytic reference (``reference``) on
+a grid of (θl, θv, |φ|) (``THETA``, ``PHI``) in ``lut/eevee_tables.py``.
+``evaluate`` is the reference times the interpolated ratio: the same
+contract as ``Closure.evaluate`` (contribution per unit irradiance, cos θl
+included; light at azimuth π, φ = 0 the mirror direction).
+
+The references (what EEVEE was found to approximate):
+
+* ``lambert``, ``oren_nayar``, ``sheen``: cos θl/π (EEVEE 5.0 draws the
+  Diffuse BSDF of any roughness and the Sheen BSDF as Lambert).
+* ``retro_toon``: max(0, l·v)/π, Lambert about the Toon's normal (the view
+  direction): EEVEE draws Toon closures as Lambert, whatever their size and
+  smooth, and does not clip the light at the surface's horizon.
+* ``glossy``: the GGX lobe D·G/(4 cos θv) of α = r² with the
+  height-correlated Smith G (Walter et al., "Microfacet models for
+  refraction through rough surfaces", EGSR 2007, Eqs. 33-34), no Fresnel:
+  EEVEE draws Beckmann lobes as GGX.
+* ``metallic``: the same times the exact unpolarized dielectric Fresnel
+  reflectance at the half vector, F(θd, n) (``lut.models.fresnel``).
+
+Between the calibrated roughnesses ``ROUGHNESS`` (and IORs ``IORS`` of the
+Metallic BSDF) the ratio tables are interpolated linearly, the reference
+taking the exact roughness and IOR; outside they are held at the ends."""
+
+from __future__ import annotations
+
+import base64
+import functools
+import io
+
+import numpy as np
+
+from .closures import Closure
+from .models import fresnel
+
+#: The grid of the tables: θl and θv in 5° steps to 90°, |φ| in 15° steps.
+THETA = np.radians(np.arange(0.0, 90.1, 5.0))
+PHI = np.radians(np.arange(0.0, 180.1, 15.0))
+#: Calibrated roughnesses (glossy, metallic) and Metallic BSDF IORs.
+ROUGHNESS = (0.05, 0.1, 0.2, 0.3, 0.45, 0.6, 0.8, 1.0)
+IORS = (1.33, 1.5, 1.7, 2.0)
+#: Kinds with tables (the closure kinds an EEVEE fit may use).
+KINDS = ("lambert", "oren_nayar", "sheen", "retro_toon", "glossy", "metallic")
+
+#: What EEVEE (Blender 5.0, one sample per pixel) sums exactly, measured by
+#: scripts/eevee_additivity.py: diffuse closures sharing the surface normal
+#: (measured with two Lambert closures: merged into one), plus at most two
+#: reflection closures (Glossy, Metallic, any roughness).  Beyond
+#: that, or with diffuse closures of different normals (a retro Toon next to
+#: a Lambert), EEVEE picks closures at random per pixel, weighted so the mean
+#: stays right: the sum is noisy (pixel spread 7-90%) until many samples
+#: average it.
+EXACT_DIFFUSE_NORMALS = 1
+EXACT_REFLECTION_CLOSURES = 2
+
+
+def table_key(closure: Closure) -> str:
+    """The table of a calibrated closure: its kind and the parameters EEVEE's
+    rendering of it was measured over."""
+    if closure.kind == "metallic":
+        return f"metallic/{closure.ior:g}/{closure.roughness:g}"
+    if closure.kind in ("glossy", "oren_nayar", "sheen"):
+        return f"{closure.kind}/{closure.roughness:g}"
+    if closure.kind == "retro_toon":
+        return f"retro_toon/{closure.size:g}/{closure.smooth:g}"
+    return closure.kind
+
+
+# ---------------------------------------------------------------------- references
+
+
+def _ggx_lobe(theta_l, theta_v, phi, roughness):
+    """D·G/(4 cos θv) of GGX, α = r², cos θl included, and cos θd (Walter
+    et al. 2007, Eqs. 33-34; height-correlated Smith G)."""
+    alpha = max(float(roughness), 1e-3) ** 2
+    sl, cl = np.sin(theta_l), np.cos(theta_l)
+    sv, cv = np.sin(theta_v), np.cos(theta_v)
+    hx, hy, hz = sv * np.cos(phi) - sl, sv * np.sin(phi), cv + cl
+    norm = np.maximum(np.sqrt(hx * hx + hy * hy + hz * hz), 1e-300)
+    cos_h = np.maximum(hz / norm, 1e-12)
+    cos_d = np.clip((-sl * hx + cl * hz) / norm, 0.0, 1.0)
+    a2 = alpha * alpha
+    tan2_h = (1.0 - cos_h * cos_h) / (cos_h * cos_h)
+    d = a2 / (np.pi * cos_h**4 * (a2 + tan2_h) ** 2)
+
+    def lam(theta):
+        t = np.tan(np.minimum(theta, np.pi / 2 - 1e-9))
+        return 0.5 * (np.sqrt(1.0 + a2 * t * t) - 1.0)
+
+    g = 1.0 / (1.0 + lam(theta_l) + lam(theta_v))
+    up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2)
+    return np.where(up, d * g / (4.0 * np.maximum(cv, 1e-12)), 0.0), cos_d
+
+
+def reference(closure: Closure, theta_l, theta_v, phi):
+    """The analytic model a kind's table corrects (module docstring)."""
+    theta_l, theta_v, phi = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (theta_l, theta_v, phi)))
+    kind = closure.kind
+    if kind in ("lambert", "oren_nayar", "sheen"):
+        return np.where(theta_l < np.pi / 2, np.cos(theta_l), 0.0) / np.pi
+    if kind == "retro_toon":
+        cos_lv = -np.sin(theta_l) * np.sin(theta_v) * np.cos(phi) + np.cos(theta_l) * np.cos(theta_v)
+        return np.maximum(cos_lv, 0.0) / np.pi
+    if kind in ("glossy", "metallic"):
+        lobe, cos_d = _ggx_lobe(theta_l, theta_v, phi, closure.roughness)
+        if kind == "glossy":
+            return lobe
+        rs, rp = fresnel.reflection_coefficients(cos_d, closure.ior)
+        return lobe * 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)
+    raise ValueError(f"EEVEE has no calibration of closure kind {kind!r} (calibrated: {', '.join(KINDS)})")
+
+
+# ---------------------------------------------------------------------- tables
+
+
+def fill(ratio):
+    """Fill a table's empty (NaN) cells from their neighbours, outward from
+    the measured cells (repeated averaging of the filled 6-neighbours)."""
+    out = np.array(ratio, dtype=float)
+    if np.all(np.isnan(out)):
+        raise ValueError("an empty calibration table")
+    while np.isnan(out).any():
+        known = ~np.isnan(out)
+        total = np.zeros_like(out)
+        count = np.zeros_like(out)
+        for axis in range(out.ndim):
+            for shift in (-1, 1):
+                src = np.roll(np.where(known, out, 0.0), shift, axis)
+                ok = np.roll(known, shift, axis)
+                edge = [slice(None)] * out.ndim
+                edge[axis] = 0 if shift == 1 else -1  # no wrap-around
+                src[tuple(edge)], ok[tuple(edge)] = 0.0, False
+                total += src
+                count += ok
+        grow = ~known & (count > 0)
+        out[grow] = total[grow] / count[grow]
+    return out
+
+
+def encode(tables: dict) -> str:
+    """A version's tables ({key: (θl, θv, φ) ratio}) as the text stored in
+    ``lut/eevee_tables.py``: a compressed .npz (float16), base64."""
+    buf = io.BytesIO()
+    np.savez_compressed(buf, **{k: np.asarray(v, dtype=np.float16) for k, v in tables.items()})
+    return base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def decode(text: str) -> dict:
+    """``encode``'s inverse: {key: float ratio table}."""
+    with np.load(io.BytesIO(base64.b64decode(text))) as data:
+        return {k: data[k].astype(float) for k in data.files}
+
+
+def _version_key(version) -> str:
+    if isinstance(version, str):
+        parts = version.split(".")
+    else:
+        parts = list(version)
+    try:
+        return f"{int(parts[0])}.{int(parts[1])}"
+    except (IndexError, ValueError, TypeError):
+        raise ValueError(f"version must be (major, minor) or 'major.minor', got {version!r}") from None
+
+
+def _stored() -> dict:
+    from . import eevee_tables
+
+    return eevee_tables.TABLES
+
+
+def available_versions() -> list:
+    """The Blender lines with tables, as (major, minor), oldest first."""
+    return sorted(tuple(int(p) for p in v.split(".")) for v in _stored())
+
+
+@functools.lru_cache(maxsize=8)
+def tables(version=(5, 0)) -> dict:
+    """The ratio tables of a Blender line ({table key: (θl, θv, φ) array})."""
+    key = _version_key(version)
+    stored = _stored()
+    if key not in stored:
+        have = ", ".join(stored) or "none"
+        raise ValueError(f"no EEVEE calibration for Blender {key} (calibrated: {have})")
+    return decode(stored[key])
+
+
+def _trilinear(table, theta_l, theta_v, phi):
+    """The table at (θl, θv, |φ|), trilinear on the grid, held at its edges."""
+    idx, frac = [], []
+    for a, grid in ((theta_l, THETA), (theta_v, THETA), (np.abs(phi), PHI)):
+        x = np.clip((a - grid[0]) / (grid[1] - grid[0]), 0.0, grid.size - 1.0)
+        i = np.minimum(np.floor(x).astype(int), grid.size - 2)
+        idx.append(i)
+        frac.append(x - i)
+    out = 0.0
+    for corner in range(8):
+        bits = [(corner >> b) & 1 for b in range(3)]
+        w = 1.0
+        for b, f in zip(bits, frac, strict=True):
+            w = w * (f if b else 1.0 - f)
+        out = out + w * table[idx[0] + bits[0], idx[1] + bits[1], idx[2] + bits[2]]
+    return out
+
+
+def _bracket(values, x):
+    """Neighbouring calibration values of x and the weight of the upper one."""
+    values = np.asarray(values, dtype=float)
+    x = float(np.clip(x, values[0], values[-1]))
+    j = int(np.clip(np.searchsorted(values, x) - 1, 0, values.size - 2))
+    t = (x - values[j]) / (values[j + 1] - values[j])
+    return values[j], values[j + 1], t
+
+
+def ratio(closure: Closure, theta_l, theta_v, phi, version=(5, 0)):
+    """EEVEE's radiance over ``reference`` for ``closure``, interpolated."""
+    data = tables(version)
+    kind = closure.kind
+    if kind in ("lambert", "oren_nayar", "sheen"):
+        keys = {k: 1.0 for k in data if k == kind or k.startswith(kind + "/")}
+    elif kind == "retro_toon":
+        keys = {k: 1.0 for k in data if k.startswith("retro_toon/")}
+    elif kind == "glossy":
+        lo, hi, t = _bracket(ROUGHNESS, closure.roughness)
+        keys = {f"glossy/{lo:g}": 1.0 - t}
+        keys[f"glossy/{hi:g}"] = keys.get(f"glossy/{hi:g}", 0.0) + t
+    elif kind == "metallic":
+        r_lo, r_hi, t = _bracket(ROUGHNESS, closure.roughness)
+        n_lo, n_hi, s = _bracket(IORS, closure.ior)
+        keys = {}
+        for n, wn in ((n_lo, 1.0 - s), (n_hi, s)):
+            for r, wr in ((r_lo, 1.0 - t), (r_hi, t)):
+                key = f"metallic/{n:g}/{r:g}"
+                keys[key] = keys.get(key, 0.0) + wn * wr
+    else:
+        raise ValueError(f"EEVEE has no calibration of closure kind {kind!r} (calibrated: {', '.join(KINDS)})")
+    if not keys or any(k not in data for k in keys):
+        raise ValueError(f"the Blender {_version_key(version)} tables lack {kind!r}")
+    total = sum(keys.values())
+    return sum((w / total) * _trilinear(data[k], theta_l, theta_v, phi) for k, w in keys.items())
+
+
+def evaluate(closure: Closure, theta_l, theta_v, phi, version=(5, 0)):
+    """EEVEE's contribution of ``closure`` per unit irradiance, cos θl
+    included (``Closure.evaluate``'s contract, as EEVEE renders it on
+    Blender line ``version``): reference × interpolated ratio.  Raises
+    ValueError for a kind not in ``KINDS`` or a version without tables."""
+    if closure.kind not in KINDS:
+        raise ValueError(f"EEVEE has no calibration of closure kind {closure.kind!r} (calibrated: {', '.join(KINDS)})")
+    theta_l, theta_v, phi = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (theta_l, theta_v, phi)))
+    value = reference(closure, theta_l, theta_v, phi) * ratio(closure, theta_l, theta_v, phi, version)
+    up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2)
+    return np.where(up, np.maximum(value, 0.0), 0.0)

@@ -1,0 +1,320 @@
+"""Measure how EEVEE renders the closures a Paint LUT fit may use, and write
+the tables ``lut.eevee`` interpolates (``lut/eevee_tables.py``).
+
+Method.  A grid of spheres (one closure each, white, unit weight) under a
+delta Sun (angle 0, no shadows) in a black world, seen by an orthographic
+camera along +Z, rendered by EEVEE at one sample per pixel with the film
+filter off, to 32-bit multilayer EXR with the Normal pass.  Every pixel is
+one geometry: from its shading normal n (the pass), the view v = +Z and the
+light l, (θl, θv, φ) in ``lut.models``' convention (light at azimuth π, φ = 0
+the mirror direction).  One render fixes the angle γ between l and v; a
+sweep of γ covers (θl, θv, |φ|).  The pixels are binned on a grid of (θl,
+θv, |φ|) and each bin stores the ratio Σ EEVEE / Σ reference of its pixels,
+the reference being a smooth analytic model of what EEVEE approximates
+(``lut.eevee.reference``): so a table cell is a slowly varying correction,
+and lobes of any roughness keep their analytic shape between cells.
+
+Run ``python scripts/calibrate_eevee.py`` with a Python whose ``bpy`` renders
+EEVEE; the tables of that Blender line (``bpy.app.version[:2]``) are added to
+the file, those of other lines kept."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import pathlib
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from lut import eevee  # noqa: E402
+from lut.closures import Closure  # noqa: E402
+
+#: The generated module of tables.
+MODULE = ROOT / "lut" / "eevee_tables.py"
+#: Pixels across one sphere's cell in the render.
+CELL = 96
+#: Angles γ between light and view of the sweep (degrees).
+GAMMAS = tuple(range(0, 176, 5))
+
+
+def calibration_closures() -> list:
+    """The closures measured: every kind an EEVEE fit may use, over
+    roughness and (for the Fresnel-weighted Metallic BSDF) IOR."""
+    out = [Closure("lambert")]
+    out += [Closure("retro_toon", a, s) for a, s in ((0.15, 0.2), (0.5, 0.6))]
+    out += [Closure("glossy", roughness=r) for r in eevee.ROUGHNESS]
+    out += [Closure("metallic", ior=n, roughness=r) for n in eevee.IORS for r in eevee.ROUGHNESS]
+    out += [Closure("oren_nayar", roughness=1.0), Closure("sheen", roughness=0.5)]
+    return out
+
+
+# ---------------------------------------------------------------------- Blender side
+
+
+def closure_shader(tree, closure: Closure, weight: float = 1.0):
+    """The output socket of ``closure`` with a white colour of ``weight``,
+    built as the add-on builds it (``addon.nodes``): coloured closures with a
+    colour, grey ones (Metallic) through a Mix Shader factor."""
+    nodes, links = tree.nodes, tree.links
+    kind = closure.kind
+    if kind == "metallic":
+        node = nodes.new("ShaderNodeBsdfMetallic")
+        node.distribution = "BECKMANN"
+        node.fresnel_type = "PHYSICAL_CONDUCTOR"
+        node.inputs["IOR"].default_value = (closure.ior,) * 3
+        node.inputs["Extinction"].default_value = (0.0, 0.0, 0.0)
+        node.inputs["Roughness"].default_value = closure.roughness
+        mix = nodes.new("ShaderNodeMixShader")
+        mix.inputs["Fac"].default_value = weight
+        links.new(node.outputs[0], mix.inputs[2])
+        return mix.outputs[0]
+    if kind in ("lambert", "oren_nayar"):
+        node = nodes.new("ShaderNodeBsdfDiffuse")
+        node.inputs["Roughness"].default_value = closure.roughness if kind == "oren_nayar" else 0.0
+    elif kind == "retro_toon":
+        node = nodes.new("ShaderNodeBsdfToon")
+        node.component = "DIFFUSE"
+        node.inputs["Size"].default_value = closure.size
+        node.inputs["Smooth"].default_value = closure.smooth
+        links.new(nodes.new("ShaderNodeNewGeometry").outputs["Incoming"], node.inputs["Normal"])
+    elif kind == "glossy":
+        node = nodes.new("ShaderNodeBsdfGlossy")
+        node.distribution = "BECKMANN"
+        node.inputs["Roughness"].default_value = closure.roughness
+    elif kind == "sheen":
+        node = nodes.new("ShaderNodeBsdfSheen")
+        node.distribution = "ASHIKHMIN"
+        node.inputs["Roughness"].default_value = closure.roughness
+    else:
+        raise ValueError(f"no calibration node set-up for closure kind {kind!r}")
+    node.inputs["Color"].default_value = (weight, weight, weight, 1.0)
+    return node.outputs[0]
+
+
+def sum_shader(tree, terms):
+    """Add Shader chain of ``terms`` [(closure, weight)]."""
+    total = None
+    for closure, weight in terms:
+        shader = closure_shader(tree, closure, weight)
+        if total is None:
+            total = shader
+        else:
+            add = tree.nodes.new("ShaderNodeAddShader")
+            tree.links.new(total, add.inputs[0])
+            tree.links.new(shader, add.inputs[1])
+            total = add.outputs[0]
+    return total
+
+
+class SphereScene:
+    """Spheres in a grid, one material each (a list of [(closure, weight)]
+    sums), an orthographic camera along +Z, a delta Sun, a black world."""
+
+    def __init__(self, materials, cell=CELL, columns=None):
+        import bpy
+
+        bpy.ops.wm.read_factory_settings(use_empty=True)
+        scene = bpy.context.scene
+        scene.render.engine = "BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else "BLENDER_EEVEE_NEXT"
+        scene.eevee.taa_render_samples = 1
+        scene.eevee.use_shadows = False
+        scene.eevee.use_raytracing = False
+        scene.eevee.clamp_surface_direct = 0.0
+        scene.render.filter_size = 0.0
+        scene.render.threads_mode = "FIXED"
+        scene.render.threads = 1
+        scene.view_settings.view_transform = "Standard"
+        world = bpy.data.worlds.new("black")
+        scene.world = world
+        world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
+        columns = columns or math.ceil(math.sqrt(len(materials)))
+        rows = math.ceil(len(materials) / columns)
+        scene.render.resolution_x, scene.render.resolution_y = columns * cell, rows * cell
+        settings = scene.render.image_settings
+        if hasattr(settings, "media_type"):  # Blender 5.0 on
+            settings.media_type = "MULTI_LAYER_IMAGE"
+        settings.file_format = "OPEN_EXR_MULTILAYER"
+        scene.render.image_settings.color_depth = "32"
+        scene.render.image_settings.exr_codec = "ZIP"
+        scene.view_layers[0].use_pass_normal = True
+        self.cells = []
+        for i, terms in enumerate(materials):
+            col, row = i % columns, i // columns
+            x, y = (col - (columns - 1) / 2) * 2.2, ((rows - 1) / 2 - row) * 2.2
+            bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=1.0, location=(x, y, 0.0))
+            sphere = bpy.context.active_object
+            bpy.ops.object.shade_smooth()
+            mat = bpy.data.materials.new(f"m{i}")
+            tree = mat.node_tree
+            for node in list(tree.nodes):
+                tree.nodes.remove(node)
+            out = tree.nodes.new("ShaderNodeOutputMaterial")
+            tree.links.new(sum_shader(tree, terms), out.inputs["Surface"])
+            sphere.data.materials.append(mat)
+            self.cells.append((row, col))
+        cam = bpy.data.cameras.new("camera")
+        cam.type = "ORTHO"
+        cam.ortho_scale = 2.2 * max(columns, rows)
+        camera = bpy.data.objects.new("camera", cam)
+        camera.location = (0.0, 0.0, 10.0)
+        scene.collection.objects.link(camera)
+        scene.camera = camera
+        sun = bpy.data.lights.new("sun", "SUN")
+        sun.energy = 1.0
+        sun.angle = 0.0
+        sun.use_shadow = False
+        self.sun = bpy.data.objects.new("sun", sun)
+        scene.collection.objects.link(self.sun)
+        self.scene, self.cell, self.columns, self.rows = scene, cell, columns, rows
+        self._path = os.path.join(tempfile.mkdtemp(prefix="eevee_calibration"), "render.exr")
+
+    def render(self, gamma):
+        """Per sphere: (θl, θv, φ, radiance (N, 3)) of its lit pixels, for the
+        light at angle ``gamma`` from the view (in the XZ plane) and unit
+        irradiance."""
+        import bpy
+        import OpenImageIO as oiio
+
+        self.sun.rotation_euler = (0.0, -gamma, 0.0)
+        self.scene.render.filepath = self._path
+        bpy.ops.render.render(write_still=True)
+        layers = {}
+        for sub in range(oiio.ImageBuf(self._path).nsubimages):  # one subimage per pass
+            buf = oiio.ImageBuf(self._path, sub, 0)
+            pixels = buf.get_pixels(oiio.FLOAT)
+            for i, name in enumerate(buf.spec().channelnames):
+                layers[name.split(".", 1)[-1]] = pixels[..., i].astype(float)
+        rgb = np.stack([layers[f"Combined.{c}"] for c in "RGB"], -1)
+        normal = np.stack([layers[f"Normal.{c}"] for c in "XYZ"], -1)
+        light = np.array([-math.sin(gamma), 0.0, math.cos(gamma)])
+        out = []
+        for row, col in self.cells:
+            sl = np.s_[row * self.cell : (row + 1) * self.cell, col * self.cell : (col + 1) * self.cell]
+            n, c = normal[sl].reshape(-1, 3), rgb[sl].reshape(-1, 3)
+            length = np.linalg.norm(n, axis=1)
+            ok = np.abs(length - 1.0) < 1e-3
+            n, c = n[ok] / length[ok, None], c[ok]
+            theta_l, theta_v, phi = geometry(n, light)
+            out.append((theta_l, theta_v, phi, c))
+        return out
+
+
+def geometry(normal, light, view=(0.0, 0.0, 1.0)):
+    """(θl, θv, φ) of unit normals (N, 3) for a light and a view direction:
+    φ the azimuth of the view from the mirror of the light's azimuth."""
+    view = np.asarray(view, dtype=float)
+    cl, cv = normal @ light, normal @ view
+    lt = light - cl[:, None] * normal
+    vt = view - cv[:, None] * normal
+    cos_phi = -np.sum(lt * vt, axis=1)
+    sin_phi = np.sum(np.cross(-lt, vt) * normal, axis=1)
+    phi = np.arctan2(sin_phi, cos_phi)
+    return np.arccos(np.clip(cl, -1.0, 1.0)), np.arccos(np.clip(cv, -1.0, 1.0)), phi
+
+
+# ---------------------------------------------------------------------- tables
+
+
+def bin_ratios(samples, closure):
+    """Σ EEVEE / Σ reference per cell of ``lut.eevee``'s grid (cell centres
+    at the grid nodes), NaN where no pixel fell or the reference is nil."""
+    tl = np.concatenate([s[0] for s in samples])
+    tv = np.concatenate([s[1] for s in samples])
+    ph = np.abs(np.concatenate([s[2] for s in samples]))
+    value = np.concatenate([s[3] for s in samples])
+    ref = eevee.reference(closure, tl, tv, ph)
+    keep = (tl < np.radians(89.0)) & (tv < np.radians(89.0))
+    idx = [
+        np.clip(np.rint(np.interp(a, g, np.arange(g.size))), 0, g.size - 1).astype(int)
+        for a, g in ((tl, eevee.THETA), (tv, eevee.THETA), (ph, eevee.PHI))
+    ]
+    shape = (eevee.THETA.size, eevee.THETA.size, eevee.PHI.size)
+    flat = np.ravel_multi_index(idx, shape)[keep]
+    num = np.bincount(flat, value[keep], np.prod(shape)).reshape(shape)
+    den = np.bincount(flat, ref[keep], np.prod(shape)).reshape(shape)
+    count = np.bincount(flat, None, np.prod(shape)).reshape(shape)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = np.where((den > 1e-6 * max(den.max(), 1e-300)) & (count >= 3), num / den, np.nan)
+    return ratio, count
+
+
+def write_module(path, version, tables):
+    """Write ``lut/eevee_tables.py``: the tables of ``version`` replace that
+    line's, other lines' are kept."""
+    path = pathlib.Path(path)
+    stored = {}
+    if path.exists():
+        scope = {}
+        exec(compile(path.read_text(), str(path), "exec"), scope)
+        stored = dict(scope["TABLES"])
+    stored[version] = eevee.encode(tables)
+    lines = [
+        '"""EEVEE calibration tables by Blender line, made by scripts/calibrate_eevee.py',
+        "(do not edit): for each line, the base64 of a compressed .npz (numpy alone reads",
+        'it: lut.eevee.decode) of per-closure ratio tables on lut.eevee\'s grid."""',
+        "",
+        "# ruff: noqa: E501",
+        "# fmt: off",
+        "TABLES = {",
+        *(f"    {v!r}: {stored[v]!r}," for v in sorted(stored)),
+        "}",
+        "",
+    ]
+    path.write_text("\n".join(lines))
+
+
+def measure(todo, per_render=25):
+    """Per closure of ``todo``: its pixels' (θl, θv, φ, EEVEE radiance of
+    the red channel) over the sweep of γ, as four float32 arrays."""
+    out = []
+    for start in range(0, len(todo), per_render):
+        batch = todo[start : start + per_render]
+        scene = SphereScene([[(c, 1.0)] for c in batch])
+        samples = [[] for _ in batch]
+        t0 = time.time()
+        for gamma in GAMMAS:
+            for i, s in enumerate(scene.render(math.radians(gamma))):
+                samples[i].append(s)
+        print(f"{len(batch)} closures, {len(GAMMAS)} renders, {time.time() - t0:.0f} s", flush=True)
+        for s in samples:
+            out.append(
+                tuple(np.concatenate([x[j] if j < 3 else x[3][:, 0] for x in s]).astype(np.float32) for j in range(4))
+            )
+    return out
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", type=pathlib.Path, default=MODULE)
+    parser.add_argument("--per-render", type=int, default=25, help="spheres per render")
+    parser.add_argument("--raw", type=pathlib.Path, help="also keep the pixels' samples in this .npz")
+    parser.add_argument("--from-raw", type=pathlib.Path, help="make the tables from samples kept by --raw")
+    args = parser.parse_args(argv)
+    todo = calibration_closures()
+    if args.from_raw:
+        raw = np.load(args.from_raw)
+        version = str(raw["version"])
+        samples = [tuple(raw[f"{eevee.table_key(c)}/{j}"] for j in range(4)) for c in todo]
+    else:
+        import bpy
+
+        version = "{}.{}".format(*bpy.app.version[:2])
+        samples = measure(todo, args.per_render)
+        if args.raw:
+            flat = {f"{eevee.table_key(c)}/{j}": s[j] for c, s in zip(todo, samples, strict=True) for j in range(4)}
+            np.savez_compressed(args.raw, version=version, **flat)
+    tables = {eevee.table_key(c): eevee.fill(bin_ratios([s], c)[0]) for c, s in zip(todo, samples, strict=True)}
+    write_module(args.out, version, tables)
+    print(f"wrote {len(tables)} tables for Blender {version} to {args.out}")
+
+
+if __name__ == "__main__":
+    main()

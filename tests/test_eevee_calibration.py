@@ -1,0 +1,137 @@
+"""lut.eevee: EEVEE's measured closure responses (scripts/calibrate_eevee.py).
+
+The evaluator's contract is checked with numpy alone; the tables themselves
+against fresh EEVEE renders of single geometries (the plane oracle, not the
+calibration's spheres) when bpy is available."""
+
+import math
+
+import numpy as np
+import pytest
+
+from lut import eevee
+from lut.closures import Closure
+
+CLOSURES = [
+    Closure("lambert"),
+    Closure("retro_toon", 0.3, 0.2),
+    Closure("glossy", roughness=0.4),
+    Closure("glossy", roughness=0.1),
+    Closure("metallic", ior=1.5, roughness=0.5),
+    Closure("metallic", ior=1.6, roughness=0.25),
+    Closure("oren_nayar", roughness=0.5),
+    Closure("sheen", roughness=0.8),
+]
+
+
+@pytest.mark.parametrize("version", eevee.available_versions())
+@pytest.mark.parametrize("closure", CLOSURES, ids=lambda c: eevee.table_key(c))
+def test_symmetric_finite_and_broadcast(closure, version):
+    tl, tv, ph = np.meshgrid(np.radians([0, 10, 45, 80, 89.9, 90]), np.radians([0, 5, 60, 89.9]), [0.0, 0.7, 3.1])
+    plus = eevee.evaluate(closure, tl, tv, ph, version)
+    minus = eevee.evaluate(closure, tl, tv, -ph, version)
+    assert plus.shape == tl.shape
+    assert np.all(np.isfinite(plus)) and np.all(plus >= 0)
+    np.testing.assert_array_equal(plus, minus)
+    # Below the horizon nothing; scalars broadcast like arrays.
+    assert np.all(plus[tl >= np.pi / 2] == 0)
+    assert eevee.evaluate(closure, 0.3, 0.4, 0.5, version) == pytest.approx(
+        eevee.evaluate(closure, np.array([0.3]), 0.4, np.array([[0.5]]), version)[0, 0]
+    )
+
+
+@pytest.mark.parametrize("closure", CLOSURES[:6], ids=lambda c: eevee.table_key(c))
+def test_smooth_in_angles_and_parameters(closure):
+    """No jumps: a small step in any angle (or roughness) changes the value
+    by a small fraction of the lobe's peak."""
+    rng = np.random.default_rng(1)
+    tl, tv, ph = rng.uniform(0, 1.35, 400), rng.uniform(0, 1.35, 400), rng.uniform(-np.pi, np.pi, 400)
+    base = eevee.evaluate(closure, tl, tv, ph)
+    peak = eevee.evaluate(closure, np.linspace(0, 1.3, 60), np.linspace(0, 1.3, 60), 0.0).max()
+    for d in (np.array([1e-3, 0, 0]), np.array([0, 1e-3, 0]), np.array([0, 0, 1e-3])):
+        step = eevee.evaluate(closure, tl + d[0], tv + d[1], ph + d[2])
+        assert np.max(np.abs(step - base)) < 0.02 * peak
+    if closure.kind in ("glossy", "metallic"):
+        import dataclasses
+
+        near = dataclasses.replace(closure, roughness=closure.roughness + 1e-3)
+        assert np.max(np.abs(eevee.evaluate(near, tl, tv, ph) - base)) < 0.02 * peak
+
+
+def test_tables_are_interpolated_exactly_at_their_nodes():
+    data = eevee.tables((5, 0))
+    closure = Closure("metallic", ior=1.5, roughness=0.3)
+    table = data[eevee.table_key(closure)]
+    i, j, k = np.meshgrid(np.arange(0, 18, 3), np.arange(0, 18, 4), np.arange(0, 13, 5), indexing="ij")
+    tl, tv, ph = eevee.THETA[i], eevee.THETA[j], eevee.PHI[k]
+    got = eevee.evaluate(closure, tl, tv, ph)
+    want = eevee.reference(closure, tl, tv, ph) * table[i, j, k]
+    np.testing.assert_allclose(got, np.maximum(want, 0.0), rtol=1e-12, atol=1e-300)
+
+
+def test_diffuse_kinds_are_lambert():
+    """What the calibration found: EEVEE draws the Diffuse BSDF (any
+    roughness) and Sheen as Lambert, and the retro Toon as Lambert about the
+    view direction."""
+    tl, tv, ph = np.meshgrid(np.radians([0, 20, 40, 60, 75]), np.radians([5, 25, 45, 65, 75]), [0.4, 1.9, 3.1])
+    lambert = np.cos(tl) / np.pi
+    for closure in (Closure("lambert"), Closure("oren_nayar", roughness=1.0), Closure("sheen", roughness=0.5)):
+        np.testing.assert_allclose(eevee.evaluate(closure, tl, tv, ph), lambert, rtol=0.02)
+    cos_lv = -np.sin(tl) * np.sin(tv) * np.cos(ph) + np.cos(tl) * np.cos(tv)
+    retro = eevee.evaluate(Closure("retro_toon", 0.3, 0.2), tl, tv, ph)
+    lit = cos_lv > 0.2
+    np.testing.assert_allclose(retro[lit], cos_lv[lit] / np.pi, rtol=0.03)
+
+
+def test_uncalibrated_kinds_and_versions_raise():
+    for kind in ("diffuse_toon", "glossy_toon", "ggx"):
+        with pytest.raises(ValueError, match=kind):
+            eevee.evaluate(Closure(kind), 0.3, 0.3, 0.0)
+    with pytest.raises(ValueError, match="3.6"):
+        eevee.evaluate(Closure("lambert"), 0.3, 0.3, 0.0, version=(3, 6))
+    assert set(eevee.KINDS) <= {"lambert", "oren_nayar", "sheen", "retro_toon", "glossy", "metallic"}
+    assert (5, 0) in eevee.available_versions()
+
+
+# ---------------------------------------------------------------------- renders
+
+#: Geometries (θl, θv, φ) off the tables' grid nodes, near and away from the mirror.
+GEOMETRIES = [(0.35, 0.5, 0.2), (0.8, 0.3, 2.4), (1.05, 1.1, 0.5), (0.2, 1.2, 1.3)]
+
+
+@pytest.fixture(scope="module")
+def oracle():
+    pytest.importorskip("bpy")
+    from blender_oracle import EEVEE, Oracle
+
+    return Oracle(irradiance=1.0, engine=EEVEE)
+
+
+@pytest.mark.parametrize(
+    "closure",
+    [
+        Closure("lambert"),
+        Closure("retro_toon", 0.3, 0.2),
+        Closure("glossy", roughness=0.4),
+        Closure("metallic", ior=1.6, roughness=0.5),
+    ],
+    ids=lambda c: eevee.table_key(c),
+)
+def test_tables_match_fresh_eevee_renders(oracle, closure):
+    """The plane oracle rendered by EEVEE at a few geometries against the
+    evaluator of the running Blender line: within 5% of the lobe's value, or
+    2% of its peak where it is small."""
+    import bpy
+
+    from scripts.calibrate_eevee import closure_shader
+
+    mat = oracle.material()
+    tree = mat.node_tree
+    tree.links.new(closure_shader(tree, closure), tree.nodes["Material Output"].inputs["Surface"])
+    version = bpy.app.version[:2]
+    peak = float(eevee.evaluate(closure, np.linspace(0, 1.3, 80), np.linspace(0, 1.3, 80), 0.0, version).max())
+    for geometry in GEOMETRIES:
+        got = float(oracle.radiance(*geometry)[0])
+        want = float(eevee.evaluate(closure, *geometry, version=version))
+        assert abs(got - want) <= max(0.05 * want, 0.02 * peak), (geometry, got, want)
+    assert math.isfinite(peak) and peak > 0
