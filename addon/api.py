@@ -232,6 +232,25 @@ def used_materials(scenes) -> set:
     return used
 
 
+def _modifier_inputs(modifier):
+    """The input values of a Geometry Nodes modifier: its ID properties up to
+    Blender 5.1, ``modifier.properties.inputs.<identifier>.value`` from 5.2
+    (where the modifier no longer holds ID properties)."""
+    try:
+        return [modifier[key] for key in modifier.keys()]
+    except TypeError:
+        pass
+    inputs = getattr(getattr(modifier, "properties", None), "inputs", None)
+    group = modifier.node_group
+    if inputs is None or group is None:
+        return []
+    values = []
+    for item in group.interface.items_tree:
+        if getattr(item, "in_out", "") == "INPUT" and hasattr(inputs, item.identifier):
+            values.append(getattr(getattr(inputs, item.identifier), "value", None))
+    return values
+
+
 def _materials_reached(scene) -> set:
     """The materials a scene's objects reach without evaluating anything."""
     used, objects, trees = set(), set(), set()
@@ -266,8 +285,8 @@ def _materials_reached(scene) -> set:
             visit_id(obj.instance_collection)
         for modifier in obj.modifiers:
             if modifier.type == "NODES":
-                for key in modifier.keys():
-                    visit_id(modifier[key])
+                for value in _modifier_inputs(modifier):
+                    visit_id(value)
                 visit_tree(modifier.node_group)
 
     while scene is not None and scene not in objects:
