@@ -15,7 +15,7 @@ import pathlib
 import bpy
 
 from . import export, nodes, properties, validation
-from ._lut import closures, lut, render
+from ._lut import closures, eevee, lut, render
 from .properties import working_space
 
 #: LUTs go here, relative to the saved .blend file.
@@ -66,6 +66,13 @@ def engine_targets():
     return closures.TARGETS
 
 
+def eevee_calibration():
+    """The Blender line whose measured EEVEE closure responses the EEVEE fit
+    uses (``lut.eevee``): this Blender's, or None where EEVEE is not
+    calibrated (Blender 4.x)."""
+    return eevee.calibration_for(bpy.app.version)
+
+
 def store_result(material, paint: lut.Paint, result: render.RenderBake, exact_metallic=None, clear_stale=True):
     """Record a finished bake on the material (LUT path relative to the
     .blend when it is saved), build or reuse its type's node groups (one per
@@ -100,8 +107,8 @@ def bake_material(material, *, directory=None, force=False, exact_metallic=None,
     exact = nodes.exact_metallic_default(exact_metallic)
     paint = paint_of(material)
     result = render.bake_for_render(
-        paint, directory or lut_directory(), targets=engine_targets(), exact_metallic=exact, force=force,
-        progress=progress, **options,
+        paint, directory or lut_directory(), targets=engine_targets(), exact_metallic=exact,
+        eevee_calibration=eevee_calibration(), force=force, progress=progress, **options,
     )  # fmt: skip
     store_result(material, paint, result, exact)
     material.paint_lut.enabled = True
@@ -314,7 +321,7 @@ def is_current(material, paint, *, directory=None, exact_metallic=None, **option
         if not path.stem.endswith(table.key[:24]):  # another type's LUT renamed onto this one's name
             return False
         for target in engine_targets():
-            fit_file = lut.fitting.fit_path(path, target, exact)
+            fit_file = lut.fitting.fit_path(path, target, exact, eevee_calibration())
             fitted = lut.fitting.read_fit(fit_file)
             if fitted.lut_key != table.key or fitted.target != target:
                 return False

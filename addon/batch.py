@@ -90,7 +90,7 @@ def linked_status(material) -> dict:
         try:
             table = lut.load_lut(path)
             for target in closures.TARGETS:
-                fitted = fitting.read_fit(fitting.fit_path(path, target, nodes.EXACT_METALLIC))
+                fitted = fitting.read_fit(fitting.fit_path(path, target, nodes.EXACT_METALLIC, api.eevee_calibration()))
                 baked_node = nodes.group_of(material, target)
                 if fitted.lut_key != table.key or baked_node is None or not nodes.is_paint_group(baked_node.node_tree):
                     raise lut.LUTError("not wired to this bake")

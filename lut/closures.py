@@ -308,31 +308,37 @@ def lobe_roughnesses(slope: float, distribution: str) -> list[float]:
     return [float(r) for r in np.unique(np.round(rough, 4))]
 
 
+def _lobes(type_dict, exact_metallic):
+    """Grey facet lobes and coloured Glossy lobes of a rough type's roughnesses."""
+    slope = float(type_dict["slope"])
+    if slope <= 0:
+        return []
+    n = type_dict["n"]
+    n = float(n if not isinstance(n, list) else sum(c / 0.5893 ** (2 * k) for k, c in enumerate(n)))
+    rough = lobe_roughnesses(slope, type_dict["distribution"])
+    grey = "metallic" if exact_metallic else "ggx"
+    return [Closure(grey, ior=n, roughness=r) for r in rough] + [Closure("glossy", roughness=r) for r in rough]
+
+
 def candidates(type_dict: dict, target: str = "CYCLES", exact_metallic: bool = True) -> list:
     """The closures a paint type may be fitted with on a render target:
     Lambert; for Cycles the Toon ramps (the subsurface terms' light-side
-    fall-off and the single scattering's view dependence); and for rough
-    types coloured Glossy lobes and grey facet lobes of the roughnesses
-    ``lobe_roughnesses``: Metallic Beckmann where Blender's Metallic BSDF is
-    the exact dielectric lobe (``exact_metallic``: Blender 5), Principled
-    GGX otherwise (Blender 4.2-4.5)."""
+    fall-off and the single scattering's view dependence), retro Toon ramps
+    and Oren-Nayar (back-scattering pigments, g < 0, brighten toward the
+    light: only these peak there); and for rough types coloured Glossy lobes
+    and grey facet lobes of the roughnesses ``lobe_roughnesses``: Metallic
+    Beckmann where Blender's Metallic BSDF is the exact dielectric lobe
+    (``exact_metallic``: Blender 5), Principled GGX otherwise (Blender
+    4.2-4.5); for Cycles above a slope of 0.3 also velvet Sheen lobes, which
+    rise toward grazing as very rough facet terms do.  EEVEE draws every
+    diffuse closure as Lambert (``lut.eevee``): Lambert and the lobes."""
     target = validate_target(target)
     basis = [Closure("lambert")]
-    if target != "EEVEE":
+    if target == "CYCLES":
         basis += _toon_candidates()
-        # Back-scattering pigments (g < 0) brighten toward the light: only
-        # Oren-Nayar's retro-reflection does; grazing-rising facet terms of
-        # very rough surfaces: the velvet sheen.
         basis += [Closure("oren_nayar", roughness=r) for r in (0.5, 1.0)]
         basis += [Closure("retro_toon", a, s) for a in (0.15, 0.3, 0.5) for s in (0.2, 0.6)]
-    slope = float(type_dict["slope"])
-    n = type_dict["n"]
-    n = float(n if not isinstance(n, list) else sum(c / 0.5893 ** (2 * k) for k, c in enumerate(n)))
-    if slope > 0:
-        rough = lobe_roughnesses(slope, type_dict["distribution"])
-        grey = "metallic" if exact_metallic else "ggx"
-        basis += [Closure(grey, ior=n, roughness=r) for r in rough]
-        basis += [Closure("glossy", roughness=r) for r in rough]
-        if target != "EEVEE" and slope > 0.3:
-            basis += [Closure("sheen", roughness=r) for r in (0.3, 0.5, 0.8, 1.0)]
+    basis += _lobes(type_dict, exact_metallic)
+    if target == "CYCLES" and float(type_dict["slope"]) > 0.3:
+        basis += [Closure("sheen", roughness=r) for r in (0.3, 0.5, 0.8, 1.0)]
     return basis

@@ -256,3 +256,19 @@ def evaluate(closure: Closure, theta_l, theta_v, phi, version=(5, 0)):
     value = reference(closure, theta_l, theta_v, phi) * ratio(closure, theta_l, theta_v, phi, version)
     up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2)
     return np.where(up, np.maximum(value, 0.0), 0.0)
+
+
+def calibration_for(blender_version):
+    """The calibrated Blender line to use for a running Blender (major,
+    minor[, patch]): the same line, else the newest calibrated line of the
+    same major version not newer than it; None when there is none (EEVEE of
+    Blender 4.x: its fit falls back on Cycles' formulas)."""
+    major, minor = int(blender_version[0]), int(blender_version[1])
+    same_major = [v for v in available_versions() if v[0] == major and v[1] <= minor]
+    return max(same_major) if same_major else None
+
+
+def is_reflection(closure: Closure) -> bool:
+    """Whether EEVEE counts the closure as a reflection closure (its
+    microfacet lobes) rather than a diffuse one (``EXACT_REFLECTION_CLOSURES``)."""
+    return closure.kind in ("glossy", "metallic", "ggx")

@@ -39,6 +39,7 @@ renders identically."""
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 import pathlib
@@ -51,7 +52,7 @@ from .nnls import nnls_gram_batch
 from .paint import COMPONENTS
 
 #: Fit format version: bumped when the weights file layout or the fit changes.
-FIT_VERSION = 2
+FIT_VERSION = 3
 
 #: The acceptance measure's geometries: θl, θv <= 75° and azimuths away from
 #: the exact mirror direction (φ = 0); the Cycles oracle tests use the same.
@@ -114,6 +115,7 @@ class Fit:
     n: float
     internal_reflectance: float
     lut_key: str = ""
+    calibration: tuple | None = None
 
     @property
     def rough(self) -> bool:
@@ -165,6 +167,7 @@ class Fit:
             "residual": self.residual.tolist(),
             "reference": self.reference.tolist(),
             "lut_key": self.lut_key,
+            "calibration": list(self.calibration) if self.calibration else None,
         }
 
 
@@ -267,10 +270,11 @@ def _nnls_fit(gram, rhs, norm, idx, upper):
     return x, float(_relative(np.maximum(err, 0.0), norm))
 
 
-def _select(gram, rhs, norm, allowed, upper, cost, budget, goal):
+def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None):
     """Forward selection of closures for every (tile, component) target.
     gram (M, K, K); rhs (M, P, K), norm (M, P, 2) over P targets; allowed
-    (P, K); upper (K,).  Returns the chosen closure indices in order."""
+    (P, K); upper (K,); caps: (mask over K, most closures of the mask).
+    Returns the chosen closure indices in order."""
     targets = [p for p in range(rhs.shape[1]) if norm[:, p, 0].sum() > 0]
     chosen: list[int] = []
     errors = {p: 1.0 for p in targets}
@@ -278,10 +282,14 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal):
     while spent < budget and targets:
         if max(errors.values()) < goal:
             break
+        capped = caps is not None and sum(caps[0][k] for k in chosen) >= caps[1]
         cands = [
             k
             for k in range(gram.shape[1])
-            if k not in chosen and allowed[targets, k].any() and spent + cost[k] <= budget
+            if k not in chosen
+            and allowed[targets, k].any()
+            and spent + cost[k] <= budget
+            and not (capped and caps[0][k])
         ]
         if not cands:
             break
@@ -319,13 +327,13 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal):
 # ---------------------------------------------------------------------- fit
 
 
-def _acceptance_grams(lut, basis, cos_view, weights):
+def _acceptance_grams(lut, basis, cos_view, weights, evaluate):
     """(residual, reference) Gram matrices (T, C, C) on ``ACCEPTANCE_GRID``."""
     tl, tv, ph = np.meshgrid(*ACCEPTANCE_GRID, indexing="ij")
     tl, tv, ph = tl.ravel(), tv.ravel(), ph.ravel()
     cos_l = np.cos(tl)
     target = lut.components(tl, tv, ph) * cos_l[:, None, None]  # (N, T, C)
-    values = np.stack([c.evaluate(tl, tv, ph) for c in basis], axis=0)  # (K, N)
+    values = np.stack([evaluate(c, tl, tv, ph) for c in basis], axis=0)  # (K, N)
     k_, c_, m_, t_ = weights.shape
     w = np.empty((k_, c_, tl.size, t_))
     for k in range(k_):
@@ -338,10 +346,30 @@ def _acceptance_grams(lut, basis, cos_view, weights):
     return np.einsum("ntc,ntd->tcd", r, r), np.einsum("ntc,ntd->tcd", ref, ref)
 
 
-def fit_lut(lut, target="CYCLES", *, exact_metallic=True, budget=None, views=VIEWS, grid=LIGHT_GRID) -> Fit:
+def _cycles(closure, theta_l, theta_v, phi):
+    return closure.evaluate(theta_l, theta_v, phi)
+
+
+def evaluator_for(target, calibration=None):
+    """How the target renders each closure: Cycles' formulas
+    (``Closure.evaluate``), or for EEVEE with a ``calibration`` (a Blender
+    line with measured tables, ``lut.eevee``) EEVEE's own responses."""
+    if target == "EEVEE" and calibration is not None:
+        from . import eevee
+
+        return functools.partial(eevee.evaluate, version=tuple(calibration))
+    return _cycles
+
+
+def fit_lut(
+    lut, target="CYCLES", *, exact_metallic=True, budget=None, views=VIEWS, grid=LIGHT_GRID, calibration=None
+) -> Fit:
     """Fit a loaded LUT (``lut.baking.LUT``) onto the closures of a render
-    target (module docstring)."""
+    target (module docstring).  ``calibration``: for EEVEE, the Blender line
+    whose measured closure responses to fit with (``lut.eevee``; None:
+    Cycles' formulas, EEVEE's own rendering unmodelled)."""
     target = closures.validate_target(target)
+    evaluate = evaluator_for(target, calibration)
     budget = BUDGET[target] if budget is None else int(budget)
     if budget < 1:
         raise ValueError(f"budget must be a whole number >= 1, got {budget!r}")
@@ -354,7 +382,7 @@ def fit_lut(lut, target="CYCLES", *, exact_metallic=True, budget=None, views=VIE
     tv = np.broadcast_to(theta_v[:, None], theta_l.shape)
     comps = lut.components(theta_l, tv, phi) * (np.cos(theta_l) * row_w)[..., None, None]  # (M, R, T, C)
     m_, r_, t_, c_ = comps.shape
-    a = np.stack([c.evaluate(theta_l, tv, phi) for c in basis], axis=-1) * row_w[..., None]  # (M, R, K)
+    a = np.stack([evaluate(c, theta_l, tv, phi) for c in basis], axis=-1) * row_w[..., None]  # (M, R, K)
     gram = np.einsum("mrk,mrl->mkl", a, a)
     b = comps.reshape(m_, r_, t_ * c_)
     rhs = np.einsum("mrk,mrp->mpk", a, b)
@@ -369,7 +397,14 @@ def fit_lut(lut, target="CYCLES", *, exact_metallic=True, budget=None, views=VIE
     upper = np.array([c.max_weight for c in basis])
     cost = np.array([c.cost for c in basis])
     goal = 0.25 * TARGET_ERROR[target]["rough" if float(type_dict["slope"]) > 0 else "smooth"]
-    chosen = _select(gram, rhs, norm, allowed, upper, cost, budget, goal**2)
+    caps = None
+    if target == "EEVEE":
+        from . import eevee
+
+        # EEVEE sums one diffuse normal and two reflection closures exactly
+        # per pixel; beyond that it picks closures at random (noise).
+        caps = (np.array([eevee.is_reflection(c) for c in basis]), eevee.EXACT_REFLECTION_CLOSURES)
+    chosen = _select(gram, rhs, norm, allowed, upper, cost, budget, goal**2, caps)
     weights = np.zeros((len(chosen), c_, m_, t_))
     for p in range(t_ * c_):
         idx = [i for i, k in enumerate(chosen) if allowed[p, k]]
@@ -384,7 +419,7 @@ def fit_lut(lut, target="CYCLES", *, exact_metallic=True, budget=None, views=VIE
     keep = [i for i in range(len(chosen)) if weights[i].max() > 0]
     basis_kept = [basis[chosen[i]] for i in keep]
     weights = weights[keep]
-    residual, reference = _acceptance_grams(lut, basis_kept, cos_view, weights) if keep else (None, None)
+    residual, reference = _acceptance_grams(lut, basis_kept, cos_view, weights, evaluate) if keep else (None, None)
     if not keep:  # nothing to fit (a type with no non-delta term): no closures, no error
         tl = ACCEPTANCE_GRID
         ref = lut.components(*np.meshgrid(*tl, indexing="ij"))
@@ -405,17 +440,22 @@ def fit_lut(lut, target="CYCLES", *, exact_metallic=True, budget=None, views=VIE
         n=n,
         internal_reflectance=lut.internal_reflectance,
         lut_key=lut.key,
+        calibration=tuple(calibration) if (calibration is not None and target == "EEVEE") else None,
     )
 
 
 # ---------------------------------------------------------------------- files
 
 
-def fit_path(lut_path, target="CYCLES", exact_metallic=True) -> pathlib.Path:
+def fit_path(lut_path, target="CYCLES", exact_metallic=True, calibration=None) -> pathlib.Path:
     """The weights file of a target beside its LUT: ``paintfit-cycles-<key>.exr``
-    (``paintfit-cycles4-…`` for Blender 4.2-4.5's lobes, ``paintfit-eevee-…``)."""
+    (``paintfit-cycles4-…`` for Blender 4.2-4.5's lobes), ``paintfit-eevee-…``
+    (``paintfit-eevee50-…`` when fitted with Blender 5.0's measured EEVEE
+    responses)."""
     lut_path = pathlib.Path(lut_path)
     name = closures.validate_target(target).lower() + ("" if exact_metallic else "4")
+    if target == "EEVEE" and calibration is not None:
+        name += "".join(str(int(v)) for v in calibration[:2])
     return lut_path.with_name(lut_path.name.replace("paintlut-", f"paintfit-{name}-"))
 
 
@@ -472,6 +512,7 @@ def read_fit(path) -> Fit:
             n=float(h["n"]),
             internal_reflectance=float(h["internal_reflectance"]),
             lut_key=h.get("lut_key", ""),
+            calibration=tuple(h["calibration"]) if h.get("calibration") else None,
         )
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         if isinstance(exc, lutfile.LUTError):

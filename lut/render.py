@@ -54,9 +54,9 @@ class RenderBake:
         return out
 
 
-def _cached_fit(path, lut, target, exact_metallic):
-    """The fit stored at ``path`` if it is valid and belongs to this LUT and
-    target, else None."""
+def _cached_fit(path, lut, target, exact_metallic, calibration):
+    """The fit stored at ``path`` if it is valid and belongs to this LUT,
+    target and calibration, else None."""
     if not pathlib.Path(path).exists():
         return None
     try:
@@ -64,6 +64,8 @@ def _cached_fit(path, lut, target, exact_metallic):
     except lutfile.LUTError:
         return None
     if fitted.lut_key != lut.key or fitted.target != target or fitted.exact_metallic != exact_metallic:
+        return None
+    if fitted.calibration != calibration:
         return None
     return fitted
 
@@ -74,13 +76,17 @@ def bake_for_render(
     *,
     targets=closures.TARGETS,
     exact_metallic=True,
+    eevee_calibration=None,
     force=False,
     progress=None,
     **lut_options,
 ) -> RenderBake:
     """Bake the paint's type LUT (``lut.bake``) and fit it for each render
     target (``lut.fitting.fit_lut``), writing the weights files beside it;
-    valid cached files are reused unless ``force``.  ``progress(fraction)``
+    valid cached files are reused unless ``force``.  ``eevee_calibration``:
+    the Blender line whose measured EEVEE closure responses the EEVEE fit
+    uses (``lut.eevee.calibration_for(bpy.app.version)``; None: Cycles'
+    formulas).  ``progress(fraction)``
     (0..1) is called throughout and may raise to cancel: files already
     complete stay (they are valid caches), nothing is half-written."""
     targets = [closures.validate_target(t) for t in targets]
@@ -98,10 +104,11 @@ def bake_for_render(
     report(LUT_SHARE)
     fits, paths = {}, {}
     for i, target in enumerate(targets):
-        fit_file = fitting.fit_path(path, target, exact_metallic)
-        fitted = None if force else _cached_fit(fit_file, table, target, exact_metallic)
+        calibration = tuple(eevee_calibration) if (target == "EEVEE" and eevee_calibration) else None
+        fit_file = fitting.fit_path(path, target, exact_metallic, calibration)
+        fitted = None if force else _cached_fit(fit_file, table, target, exact_metallic, calibration)
         if fitted is None:
-            fitted = fitting.fit_lut(table, target, exact_metallic=exact_metallic)
+            fitted = fitting.fit_lut(table, target, exact_metallic=exact_metallic, calibration=calibration)
             fitting.write_fit(fitted, fit_file)
             computed.append(target)
         fits[target], paths[target] = fitted, fit_file
