@@ -8,6 +8,7 @@ alike; numpy only."""
 
 from __future__ import annotations
 
+import concurrent.futures
 import dataclasses
 import pathlib
 
@@ -103,16 +104,36 @@ def bake_for_render(
         computed.append("lut")
     report(LUT_SHARE)
     fits, paths = {}, {}
-    for i, target in enumerate(targets):
+    fits, paths, todo = {}, {}, {}
+    for target in targets:
         calibration = tuple(eevee_calibration) if (target == "EEVEE" and eevee_calibration) else None
-        fit_file = fitting.fit_path(path, target, exact_metallic, calibration)
-        fitted = None if force else _cached_fit(fit_file, table, target, exact_metallic, calibration)
+        paths[target] = fitting.fit_path(path, target, exact_metallic, calibration)
+        fitted = None if force else _cached_fit(paths[target], table, target, exact_metallic, calibration)
         if fitted is None:
-            fitted = fitting.fit_lut(table, target, exact_metallic=exact_metallic, calibration=calibration)
-            fitting.write_fit(fitted, fit_file)
-            computed.append(target)
-        fits[target], paths[target] = fitted, fit_file
-        report(LUT_SHARE + (1.0 - LUT_SHARE) * (i + 1) / len(targets))
+            todo[target] = calibration
+        else:
+            fits[target] = fitted
+    # The engines' fits are independent: one thread each (numpy releases the
+    # interpreter lock in their array work); files are written and progress
+    # reported (where a cancel is raised) on this thread.
+    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, len(todo))) as pool:
+        futures = {
+            pool.submit(fitting.fit_lut, table, target, exact_metallic=exact_metallic, calibration=calibration): target
+            for target, calibration in todo.items()
+        }
+        try:
+            for future in concurrent.futures.as_completed(futures):
+                target = futures[future]
+                fits[target] = future.result()
+                fitting.write_fit(fits[target], paths[target])
+                computed.append(target)
+                report(LUT_SHARE + (1.0 - LUT_SHARE) * len(fits) / len(targets))
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            raise
+    fits = {target: fits[target] for target in targets}
+    computed.sort(key=lambda name: ["lut", *targets].index(name))
     return RenderBake(path, table, fits, paths, computed)
 
 
