@@ -400,7 +400,8 @@ def test_colour_as_seen_sets_the_pigment_that_shows_it(material, lut_dir):
     assert tuple(settings.rho) == pytest.approx(tuple(rho), abs=1e-5)
     assert not settings.stale and _inputs(material)["Pigment Color"] == pytest.approx(tuple(rho), abs=1e-5)
     assert rho[0] > 0.5  # the pigment is lighter than what is seen through the interface
-    seen_group = next(g for g in bpy.data.node_groups if g.name.startswith("Paint LUT As Seen"))
+    key = lut.load_lut(bpy.path.abspath(settings.lut_path)).key
+    seen_group = bpy.data.node_groups[f"Paint LUT As Seen {key[:8]}"]
     assert {(s.name, s.in_out) for s in seen_group.interface.items_tree} == {
         ("Color (as seen)", "INPUT"),
         ("Pigment Color", "OUTPUT"),

@@ -224,7 +224,7 @@ def test_the_as_seen_group_computes_the_pigment_in_nodes(registered_oracle, tmp_
 
     oracle = registered_oracle
     material, result = paint_material(oracle, lut.Paint(rho=0.5, slope=0.3), tmp_path, resolution=(16, 8, 4))
-    group = next(g for g in bpy.data.node_groups if g.name.startswith("Paint LUT As Seen"))
+    group = bpy.data.node_groups[f"Paint LUT As Seen {result.lut.key[:8]}"]  # this paint type's
     tree = material.node_tree
     node = tree.nodes.new("ShaderNodeGroup")
     node.node_tree = group
