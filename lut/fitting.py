@@ -375,7 +375,10 @@ def fit_lut(
         raise ValueError(f"budget must be a whole number >= 1, got {budget!r}")
     meta = lut.meta
     type_dict = meta["type"]
-    basis = closures.candidates(type_dict, target, exact_metallic)
+    # A calibrated EEVEE (Blender 5) draws the Metallic BSDF as measured,
+    # whatever Cycles makes of it: its lobes are Metallic ones.
+    metallic = exact_metallic or (target == "EEVEE" and calibration is not None)
+    basis = closures.candidates(type_dict, target, metallic)
     cos_view = view_cosines(views)
     theta_v = np.arccos(np.clip(cos_view, np.cos(MAX_VIEW), 1.0))
     theta_l, phi, row_w = light_rows(theta_v, grid)
