@@ -327,9 +327,10 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None):
 # ---------------------------------------------------------------------- fit
 
 
-def _acceptance_grams(lut, basis, cos_view, weights, evaluate):
-    """(residual, reference) Gram matrices (T, C, C) on ``ACCEPTANCE_GRID``."""
-    tl, tv, ph = np.meshgrid(*ACCEPTANCE_GRID, indexing="ij")
+def _acceptance_grams(lut, basis, cos_view, weights, evaluate, grid=ACCEPTANCE_GRID):
+    """(residual, reference) Gram matrices (T, C, C) on ``grid`` (default
+    ``ACCEPTANCE_GRID``)."""
+    tl, tv, ph = np.meshgrid(*grid, indexing="ij")
     tl, tv, ph = tl.ravel(), tv.ravel(), ph.ravel()
     cos_l = np.cos(tl)
     target = lut.components(tl, tv, ph) * cos_l[:, None, None]  # (N, T, C)

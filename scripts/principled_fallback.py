@@ -20,21 +20,11 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
 
 import bpy  # noqa: E402,F401
-from blender_oracle import Oracle, paints, principled, relative_rms  # noqa: E402
+from blender_oracle import Oracle, paints, principled, principled_params_material, relative_rms  # noqa: E402
 
 from lut import principled as fallback  # noqa: E402
 
-
-def fallback_material(oracle, params):
-    """The fallback's Principled BSDF on the oracle's plane."""
-    mat = oracle.material("fallback")
-    nodes, links = mat.node_tree.nodes, mat.node_tree.links
-    bsdf = nodes.new("ShaderNodeBsdfPrincipled")
-    bsdf.distribution = "GGX"
-    for name, value in params.node_inputs().items():
-        bsdf.inputs[name].default_value = value
-    links.new(bsdf.outputs[0], nodes["Material Output"].inputs["Surface"])
-    return mat
+fallback_material = principled_params_material
 
 
 def main(argv=None) -> int:

@@ -173,3 +173,16 @@ def principled(oracle, paint):
     bsdf.inputs["Roughness"].default_value = min(1.0, math.sqrt(paint.slope))
     links.new(bsdf.outputs[0], nodes["Material Output"].inputs["Surface"])
     return mat
+
+
+def principled_params_material(oracle, params):
+    """A Principled BSDF (single-scatter GGX) with ``lut.principled``
+    parameters on the plane: the export fallback as Cycles renders it."""
+    mat = oracle.material("fallback")
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    bsdf = nodes.new("ShaderNodeBsdfPrincipled")
+    bsdf.distribution = "GGX"
+    for name, value in params.node_inputs().items():
+        bsdf.inputs[name].default_value = value
+    links.new(bsdf.outputs[0], nodes["Material Output"].inputs["Surface"])
+    return mat

@@ -12,7 +12,7 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-from blender_oracle import EEVEE, Oracle, relative_rms  # noqa: E402
+from blender_oracle import EEVEE, Oracle, principled_params_material, relative_rms  # noqa: E402
 from blender_oracle import principled as artists_principled  # noqa: E402
 
 import lut  # noqa: E402
@@ -29,15 +29,7 @@ def oracle(addon_registered):
     return Oracle()
 
 
-def _principled_material(oracle, params):
-    mat = oracle.material("fallback")
-    nodes, links = mat.node_tree.nodes, mat.node_tree.links
-    bsdf = nodes.new("ShaderNodeBsdfPrincipled")
-    bsdf.distribution = "GGX"
-    for name, value in params.node_inputs().items():
-        bsdf.inputs[name].default_value = value
-    links.new(bsdf.outputs[0], nodes["Material Output"].inputs["Surface"])
-    return mat
+_principled_material = principled_params_material
 
 
 @pytest.mark.parametrize(
