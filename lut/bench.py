@@ -181,7 +181,7 @@ def bake_time_vs_error(paints, settings=BAKE_SETTINGS, directory=None, count=200
                 start = time.perf_counter()
                 path = baking.bake(paint, directory, resolution=resolution, single_nodes=single_nodes, force=True)
                 seconds = time.perf_counter() - start
-                err = cos_weighted_error(baking.load_lut(path).evaluate(ti, ts, ps), ref, ti)
+                err = cos_weighted_error(baking.load_lut(path).evaluate(ti, ts, ps, paint), ref, ti)
                 rows.append({"resolution": resolution, "single_nodes": single_nodes, "seconds": seconds, "error": err})
             report[name] = rows
     return report
