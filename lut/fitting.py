@@ -145,12 +145,6 @@ class Fit:
         these amplitudes ((3 channels, 3 components): ``Paint.amplitudes``)."""
         return acceptance_error(self.residual, self.reference, amplitudes)
 
-    def worst_error(self) -> float:
-        """The largest error over colours: the worst component's alone (the
-        error of a sum of non-negative components lies below it up to the
-        components' overlap; ``error`` is exact for a given colour)."""
-        return max((e for e in self.component_errors().values() if e is not None), default=0.0)
-
     def header(self) -> dict:
         return {
             "fit_version": FIT_VERSION,

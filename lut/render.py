@@ -44,16 +44,6 @@ class RenderBake:
         amps = self.lut.amplitudes(paint)
         return {target: fit.error(amps) for target, fit in self.fits.items()}
 
-    def misses(self, paint: Paint) -> dict:
-        """{target: (error, target error)} for the targets whose fit misses
-        its goal for this paint's colours."""
-        out = {}
-        for target, error in self.errors(paint).items():
-            goal = self.fits[target].target_error
-            if error > goal:
-                out[target] = (error, goal)
-        return out
-
 
 def _cached_fit(path, lut, target, exact_metallic, calibration):
     """The fit stored at ``path`` if it is valid and belongs to this LUT,
