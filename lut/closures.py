@@ -49,6 +49,7 @@ import dataclasses
 import numpy as np
 
 from .models import facet, fresnel
+from .paint import reference_index
 
 
 @dataclasses.dataclass(frozen=True)
@@ -313,8 +314,7 @@ def _lobes(type_dict, exact_metallic):
     slope = float(type_dict["slope"])
     if slope <= 0:
         return []
-    n = type_dict["n"]
-    n = float(n if not isinstance(n, list) else sum(c / 0.5893 ** (2 * k) for k, c in enumerate(n)))
+    n = reference_index(type_dict["n"])
     rough = lobe_roughnesses(slope, type_dict["distribution"])
     grey = "metallic" if exact_metallic else "ggx"
     return [Closure(grey, ior=n, roughness=r) for r in rough] + [Closure("glossy", roughness=r) for r in rough]

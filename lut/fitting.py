@@ -49,7 +49,7 @@ import numpy as np
 from . import closures, lutfile
 from .closures import Closure
 from .nnls import nnls_gram_batch
-from .paint import COMPONENTS
+from .paint import COMPONENTS, reference_index
 
 #: Fit format version: bumped when the weights file layout or the fit changes.
 FIT_VERSION = 3
@@ -423,8 +423,7 @@ def fit_lut(
         ref = lut.components(*np.meshgrid(*tl, indexing="ij"))
         reference = np.einsum("...tc,...td->tcd", ref, ref)
         residual = reference.copy()
-    n = type_dict["n"]
-    n = float(n if not isinstance(n, list) else sum(c / 0.5893 ** (2 * k) for k, c in enumerate(n)))
+    n = reference_index(type_dict["n"])
     return Fit(
         target=target,
         exact_metallic=bool(exact_metallic),

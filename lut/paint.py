@@ -112,6 +112,15 @@ def _cauchy(coeffs, wavelength_um):
     return sum(c / wavelength_um ** (2 * k) for k, c in enumerate(coeffs))
 
 
+def reference_index(n) -> float:
+    """The index of a paint type's ``n`` (a number, or Cauchy coefficients as
+    stored in a type's JSON) at ``REFERENCE_WAVELENGTH``: the index a
+    renderer's single-IOR closures take."""
+    if isinstance(n, (int, float)):
+        return float(n)
+    return float(_cauchy(tuple(n), REFERENCE_WAVELENGTH / 1000.0))
+
+
 @dataclasses.dataclass(frozen=True)
 class Paint:
     """A paint (paper Sec. 4).  All fields are keywords; see the module
