@@ -328,7 +328,7 @@ def _acceptance_grams(lut, basis, cos_view, weights, evaluate, grid=ACCEPTANCE_G
     tl, tv, ph = tl.ravel(), tv.ravel(), ph.ravel()
     cos_l = np.cos(tl)
     target = lut.components(tl, tv, ph) * cos_l[:, None, None]  # (N, T, C)
-    values = np.stack([evaluate(c, tl, tv, ph) for c in basis], axis=0)  # (K, N)
+    values = np.array([evaluate(c, tl, tv, ph) for c in basis]).reshape(len(basis), tl.size)  # (K, N); K may be 0
     k_, c_, m_, t_ = weights.shape
     w = np.empty((k_, c_, tl.size, t_))
     for k in range(k_):
@@ -417,12 +417,7 @@ def fit_lut(
     keep = [i for i in range(len(chosen)) if weights[i].max() > 0]
     basis_kept = [basis[chosen[i]] for i in keep]
     weights = weights[keep]
-    residual, reference = _acceptance_grams(lut, basis_kept, cos_view, weights, evaluate) if keep else (None, None)
-    if not keep:  # nothing to fit (a type with no non-delta term): no closures, no error
-        tl = ACCEPTANCE_GRID
-        ref = lut.components(*np.meshgrid(*tl, indexing="ij"))
-        reference = np.einsum("...tc,...td->tcd", ref, ref)
-        residual = reference.copy()
+    residual, reference = _acceptance_grams(lut, basis_kept, cos_view, weights, evaluate)
     n = reference_index(type_dict["n"])
     return Fit(
         target=target,
