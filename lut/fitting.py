@@ -21,7 +21,8 @@ The fit, per render target (``fit_lut``):
    none of those helps: near-collinear Toon ramps mislead the
    unconstrained ranking), until the render
    cost budget (closures per material) is spent or the error is far below
-   target.  Grey closures (no colour input) serve the facet component only
+   target; a few closures more (``EXTRA_BUDGET``) while a component's
+   error is still above the target.  Grey closures (no colour input) serve the facet component only
    and keep weights <= 1 (a Mix Shader factor clamps there).
 3. Weights.  Non-negative least squares per view and component over the
    chosen closures (``lut.nnls``).
@@ -52,7 +53,7 @@ from .nnls import nnls_gram_batch
 from .paint import COMPONENTS, reference_index
 
 #: Fit format version: bumped when the weights file layout or the fit changes.
-FIT_VERSION = 3
+FIT_VERSION = 4
 
 #: The acceptance measure's geometries: θl, θv <= 75° and azimuths away from
 #: the exact mirror direction (φ = 0); the Cycles oracle tests use the same.
@@ -70,6 +71,10 @@ TARGET_ERROR = {"CYCLES": {"smooth": 0.02, "rough": 0.05}, "EEVEE": {"smooth": 0
 #: Closures per material (render cost grows with their number; the mirror
 #: of a smooth type comes on top).  EEVEE evaluates few closures per pixel.
 BUDGET = {"CYCLES": 8, "EEVEE": 3}
+#: Closures a fit may add beyond ``BUDGET`` while a component's error is
+#: still above the target: only the types that need them (very rough facets,
+#: strongly back-scattering pigments) pay the render cost.
+EXTRA_BUDGET = {"CYCLES": 4, "EEVEE": 0}
 
 #: Views (columns of the weights texture) and the light grid of each view.
 VIEWS = 24
@@ -264,17 +269,23 @@ def _nnls_fit(gram, rhs, norm, idx, upper):
     return x, float(_relative(np.maximum(err, 0.0), norm))
 
 
-def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None):
+def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None, extra=(0, np.inf)):
     """Forward selection of closures for every (tile, component) target.
     gram (M, K, K); rhs (M, P, K), norm (M, P, 2) over P targets; allowed
-    (P, K); upper (K,); caps: (mask over K, most closures of the mask).
-    Returns the chosen closure indices in order."""
+    (P, K); upper (K,); caps: (mask over K, most closures of the mask);
+    goal: the relative squared error below which selection stops; extra:
+    (closures, relative squared error) — up to that many closures beyond
+    ``budget`` while some target's error is above that.  Returns the chosen
+    closure indices in order."""
     targets = [p for p in range(rhs.shape[1]) if norm[:, p, 0].sum() > 0]
     chosen: list[int] = []
     errors = {p: 1.0 for p in targets}
     spent = 0
-    while spent < budget and targets:
+    while targets:
         if max(errors.values()) < goal:
+            break
+        limit = budget + extra[0] if max(errors.values()) > extra[1] else budget
+        if spent >= limit:
             break
         capped = caps is not None and sum(caps[0][k] for k in chosen) >= caps[1]
         cands = [
@@ -282,7 +293,7 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None):
             for k in range(gram.shape[1])
             if k not in chosen
             and allowed[targets, k].any()
-            and spent + cost[k] <= budget
+            and spent + cost[k] <= limit
             and not (capped and caps[0][k])
         ]
         if not cands:
@@ -357,17 +368,30 @@ def evaluator_for(target, calibration=None):
 
 
 def fit_lut(
-    lut, target="CYCLES", *, exact_metallic=True, budget=None, views=VIEWS, grid=LIGHT_GRID, calibration=None
+    lut,
+    target="CYCLES",
+    *,
+    exact_metallic=True,
+    budget=None,
+    extra_budget=None,
+    views=VIEWS,
+    grid=LIGHT_GRID,
+    calibration=None,
 ) -> Fit:
     """Fit a loaded LUT (``lut.baking.LUT``) onto the closures of a render
-    target (module docstring).  ``calibration``: for EEVEE, the Blender line
-    whose measured closure responses to fit with (``lut.eevee``; None:
-    Cycles' formulas, EEVEE's own rendering unmodelled)."""
+    target (module docstring).  ``budget``, ``extra_budget``: closures per
+    material, and how many more while a component misses the target
+    (defaults ``BUDGET``, ``EXTRA_BUDGET``).  ``calibration``: for EEVEE, the
+    Blender line whose measured closure responses to fit with (``lut.eevee``;
+    None: Cycles' formulas, EEVEE's own rendering unmodelled)."""
     target = closures.validate_target(target)
     evaluate = evaluator_for(target, calibration)
     budget = BUDGET[target] if budget is None else int(budget)
     if budget < 1:
         raise ValueError(f"budget must be a whole number >= 1, got {budget!r}")
+    extra_budget = EXTRA_BUDGET[target] if extra_budget is None else int(extra_budget)
+    if extra_budget < 0:
+        raise ValueError(f"extra_budget must be a whole number >= 0, got {extra_budget!r}")
     meta = lut.meta
     type_dict = meta["type"]
     # A calibrated EEVEE (Blender 5) draws the Metallic BSDF as measured,
@@ -394,7 +418,8 @@ def fit_lut(
     allowed = np.array([[not grey[k] or p % c_ == facet for k in range(len(basis))] for p in range(t_ * c_)])
     upper = np.array([c.max_weight for c in basis])
     cost = np.array([c.cost for c in basis])
-    goal = 0.25 * TARGET_ERROR[target]["rough" if float(type_dict["slope"]) > 0 else "smooth"]
+    target_error = TARGET_ERROR[target]["rough" if float(type_dict["slope"]) > 0 else "smooth"]
+    goal = 0.25 * target_error
     caps = None
     if target == "EEVEE":
         from . import eevee
@@ -402,7 +427,7 @@ def fit_lut(
         # EEVEE sums one diffuse normal and two reflection closures exactly
         # per pixel; beyond that it picks closures at random (noise).
         caps = (np.array([eevee.is_reflection(c) for c in basis]), eevee.EXACT_REFLECTION_CLOSURES)
-    chosen = _select(gram, rhs, norm, allowed, upper, cost, budget, goal**2, caps)
+    chosen = _select(gram, rhs, norm, allowed, upper, cost, budget, goal**2, caps, (extra_budget, target_error**2))
     weights = np.zeros((len(chosen), c_, m_, t_))
     for p in range(t_ * c_):
         idx = [i for i, k in enumerate(chosen) if allowed[p, k]]
