@@ -247,3 +247,50 @@ def render_bake_times(paints, directory, repeat=1, eevee_calibration=(5, 0)):
                     best = row
         rows.append((label, *best))
     return rows
+
+
+#: Bins of the dense fidelity measure (``binned_error``): θl and θv in 5°
+#: steps up to 75° (the acceptance measure's range), |φ| in 15° steps from
+#: 20° (away from the mirror direction, as the acceptance grid is).
+BIN_THETA = np.radians(np.arange(0.0, 75.1, 5.0))
+BIN_PHI = np.radians(np.arange(20.0, 180.1, 15.0))
+
+
+def binned_error(theta_l, theta_v, phi, rendered, model, min_pixels=3):
+    """The acceptance measure on pixel samples of any geometry (e.g. the
+    pixels of spheres under a sun, each its own (θl, θv, φ)): the samples are
+    binned on (θl, θv, |φ|) (``BIN_THETA``, ``BIN_PHI``; bin centres at the
+    nodes), each bin's mean rendered and model radiance compared, and the
+    bins weighted by cos θl as the acceptance measure weights its grid
+    points: sqrt(Σ cos²θl·|mean rendered − mean model|² / Σ cos²θl·|mean
+    model|²) over bins with at least ``min_pixels`` samples, all channels.
+    ``rendered`` and ``model`` are radiances (N, 3) per unit irradiance
+    (f·cos θl).  Returns (error, bins used)."""
+    theta_l, theta_v, phi = (np.asarray(a, dtype=float).ravel() for a in (theta_l, theta_v, phi))
+    rendered = np.asarray(rendered, dtype=float).reshape(theta_l.size, -1)
+    model = np.asarray(model, dtype=float).reshape(theta_l.size, -1)
+    ph = np.abs(phi)
+    step_t, step_p = BIN_THETA[1] - BIN_THETA[0], BIN_PHI[1] - BIN_PHI[0]
+    inside = (
+        (theta_l <= BIN_THETA[-1] + step_t / 2)
+        & (theta_v <= BIN_THETA[-1] + step_t / 2)
+        & (ph >= BIN_PHI[0] - step_p / 2)
+    )
+    il = np.clip(np.rint(theta_l / step_t), 0, BIN_THETA.size - 1).astype(int)
+    iv = np.clip(np.rint(theta_v / step_t), 0, BIN_THETA.size - 1).astype(int)
+    ip = np.clip(np.rint((ph - BIN_PHI[0]) / step_p), 0, BIN_PHI.size - 1).astype(int)
+    shape = (BIN_THETA.size, BIN_THETA.size, BIN_PHI.size)
+    flat = np.ravel_multi_index((il, iv, ip), shape)[inside]
+    size = int(np.prod(shape))
+    count = np.bincount(flat, minlength=size)
+    used = count >= min_pixels
+    if not used.any():
+        raise ValueError("no bin of the measure holds enough samples")
+    weight = np.cos(BIN_THETA)[np.unravel_index(np.arange(size), shape)[0]][used]
+    num = den = 0.0
+    for c in range(rendered.shape[1]):
+        got = np.bincount(flat, rendered[inside, c], size)[used] / count[used]
+        want = np.bincount(flat, model[inside, c], size)[used] / count[used]
+        num += np.sum((weight * (got - want)) ** 2)
+        den += np.sum((weight * want) ** 2)
+    return float(np.sqrt(num / den)), int(used.sum())

@@ -115,8 +115,9 @@ def sum_shader(tree, terms):
 
 
 class SphereScene:
-    """Spheres in a grid, one material each (a list of [(closure, weight)]
-    sums), an orthographic camera along +Z, a delta Sun, a black world."""
+    """Spheres in a grid (``objects``), one material each (a list of
+    [(closure, weight)] sums; None: no material, for the caller to assign),
+    an orthographic camera along +Z, a delta Sun, a black world."""
 
     def __init__(self, materials, cell=CELL, columns=None):
         import bpy
@@ -145,13 +146,17 @@ class SphereScene:
         scene.render.image_settings.color_depth = "32"
         scene.render.image_settings.exr_codec = "ZIP"
         scene.view_layers[0].use_pass_normal = True
-        self.cells = []
+        self.cells, self.objects = [], []
         for i, terms in enumerate(materials):
             col, row = i % columns, i // columns
             x, y = (col - (columns - 1) / 2) * 2.2, ((rows - 1) / 2 - row) * 2.2
             bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=1.0, location=(x, y, 0.0))
             sphere = bpy.context.active_object
             bpy.ops.object.shade_smooth()
+            self.objects.append(sphere)
+            self.cells.append((row, col))
+            if terms is None:
+                continue
             mat = bpy.data.materials.new(f"m{i}")
             tree = mat.node_tree
             for node in list(tree.nodes):
@@ -159,7 +164,6 @@ class SphereScene:
             out = tree.nodes.new("ShaderNodeOutputMaterial")
             tree.links.new(sum_shader(tree, terms), out.inputs["Surface"])
             sphere.data.materials.append(mat)
-            self.cells.append((row, col))
         cam = bpy.data.cameras.new("camera")
         cam.type = "ORTHO"
         cam.ortho_scale = 2.2 * max(columns, rows)
