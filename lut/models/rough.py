@@ -52,7 +52,7 @@ import numpy as np
 
 from . import _validate, distributions, fresnel, geometry, phase, smooth
 from .geometry import cross, dot
-from .mueller import jones_to_mueller
+from .mueller import jones_product_m00, jones_to_mueller
 
 #: Default (radial nodes per segment, azimuthal nodes) of the visible-normal
 #: rule; see docs/models.md for the error each reaches.
@@ -333,9 +333,11 @@ def _single_sum(ti, ts, ps, n, g, slope, distribution, nodes_in, nodes_out, muel
             a["weight"][:, :, None] * b["weight"][:, None, :] * phase.rayleigh_factor(cos_sc, g) * inv_depth / (n * n)
         )
         if not mueller:
-            t1s, t1p = (a[key][:, :, None] ** 2 for key in ("t_s", "t_p"))
-            t2s, t2p = (b[key][:, None, :] ** 2 for key in ("t_s", "t_p"))
-            m00 = 0.5 * (t2s * (v_ss**2 * t1s + v_sp**2 * t1p) + t2p * (v_ps**2 * t1s + v_pp**2 * t1p))
+            m00 = jones_product_m00(
+                (b["t_s"][:, None, :], b["t_p"][:, None, :]),
+                ((v_ss, v_sp), (v_ps, v_pp)),
+                (a["t_s"][:, :, None], a["t_p"][:, :, None]),
+            )
             out[sl] = np.sum(weight * m00, axis=(1, 2))
             continue
         v = np.stack((np.stack((v_ss, v_sp), -1), np.stack((v_ps, v_pp), -1)), -2)
@@ -404,10 +406,7 @@ def rough_single_random(theta_i, theta_s, phi_s, *, n, g, slope, distribution="g
         with np.errstate(divide="ignore", invalid="ignore"):
             beam = np.where(good, n * c1t / cos1 * n * c2t / cos2, 0.0)
         cos_sc = np.clip(dot(k1, k2), -1.0, 1.0)
-        m00 = 0.5 * (
-            t2s**2 * (dot(s2, s1) ** 2 * t1s**2 + dot(s2, p1) ** 2 * t1p**2)
-            + t2p**2 * (dot(p2, s1) ** 2 * t1s**2 + dot(p2, p1) ** 2 * t1p**2)
-        )
+        m00 = jones_product_m00((t2s, t2p), ((dot(s2, s1), dot(s2, p1)), (dot(p2, s1), dot(p2, p1))), (t1s, t1p))
         depth = np.abs(k1[..., 2]) + np.abs(k2[..., 2])
         inv_depth = np.divide(1.0, depth, out=np.zeros_like(depth), where=depth > 0.0)
         value = beam * phase.rayleigh_factor(cos_sc, g) * m00 * inv_depth / (n * n)
