@@ -5,6 +5,9 @@ facet normals per direction pair, one normal drawn for the incident ray and one
 for the scattered ray from the slope distribution as seen by that ray
 (Eq. 36).  Here the same average is computed by deterministic quadrature:
 
+The paper's random-pairs average itself is kept, as a check only, in
+``reference.rough_single_random``.
+
 * **Visible-normal rule.**  For a direction u (towards the source or the
   viewer) the facets it meets have density P(ζ) max(cos ι, 0) sec θn per
   dζx dζy (Eq. 36), normalized exactly (each ray meets one facet; the paper's
@@ -242,7 +245,7 @@ def rough_diffuse(
 # --------------------------------------------------------------------------- single
 
 
-def _local_basis(k_ext, k_int, h):
+def local_basis(k_ext, k_int, h):
     """Local s vector of the facet and the p vectors of the external and the
     internal ray (paper Eq. 40); the s vector falls back to the global one at
     normal incidence on the facet, where the choice does not matter."""
@@ -285,7 +288,7 @@ def _prepare(theta, n, slope, distribution, nodes, entering):
     the ray's global s/p basis and the facet's internal one: A = diag(t_s,
     t_p)·R on entry; on exit its transpose, B = Rᵀ·diag(t_s, t_p)."""
     st = _facet_states(theta, n, slope, distribution, nodes, entering)
-    s_loc, _, p_int = _local_basis(st["k"], st["k_in"], st["h"])
+    s_loc, _, p_int = local_basis(st["k"], st["k_in"], st["h"])
     heading = st["k_in"][..., 2] < 0.0 if entering else st["k_in"][..., 2] > 0.0
     st["weight"] = np.where(heading, st["w"] * st["beam"], 0.0)
     st["depth"] = np.abs(st["k_in"][..., 2])
@@ -348,70 +351,3 @@ def _single_sum(ti, ts, ps, n, g, slope, distribution, nodes_in, nodes_out, muel
         out[sl] = np.sum(weight[..., None, None] * jones_to_mueller(jones), axis=(1, 2))
     out[~lit] = 0.0
     return out.reshape(shape + ((4, 4) if mueller else ()))
-
-
-# --------------------------------------------------------------------------- paper's method
-
-
-def _area_normals(rng, shape, slope, distribution):
-    """Random facet normals distributed as P(ζ) dζx dζy (uniform on the mean
-    plane), the paper's first random surface-normal generator."""
-    if distribution == "gaussian":
-        zeta = slope * np.sqrt(rng.standard_exponential(shape))
-    else:
-        zeta = slope * rng.standard_gamma(2.0, shape) / distributions.SQRT6
-    phi = rng.uniform(-np.pi, np.pi, shape)
-    norm = np.sqrt(1.0 + zeta * zeta)
-    return np.stack((zeta * np.cos(phi) / norm, zeta * np.sin(phi) / norm, 1.0 / norm), axis=-1)
-
-
-def rough_single_random(theta_i, theta_s, phi_s, *, n, g, slope, distribution="gaussian", pairs=5000, seed=0):
-    """M00 of ``rough_single`` by the paper's Monte Carlo method (Sec. 2.5):
-    for every direction pair, ``pairs`` independent pairs of random facet
-    normals, one met by the incident and one by the scattered ray, averaged.
-    Kept as the baseline of the benchmark (scripts/benchmark_models.py); the
-    quadrature of ``rough_single`` is the production path.
-
-    The normals seen by a ray are drawn from the area distribution and
-    weighted by their projected area max(cos ι, 0) sec θn (Eq. 36) with a
-    self-normalized average, rather than by the paper's rejection step;
-    both sample the same distribution."""
-    n = _validate.index(n)
-    g = _validate.asymmetry(g)
-    slope = _validate.rms_slope(slope)
-    distribution = _validate.distribution(distribution)
-    pairs = _validate.positive_int(pairs, "pairs")
-    ti, ts, ps = (a.ravel() for a in _validate.angles(theta_i, theta_s, phi_s))
-    shape = np.broadcast(theta_i, theta_s, phi_s).shape
-    rng = np.random.default_rng(seed)
-    out = np.zeros(ti.shape)
-    chunk = max(1, CHUNK_PAIRS // pairs)
-    for start in range(0, ti.size, chunk):
-        sl = slice(start, start + chunk)
-        k_i = geometry.incident(ti[sl])[:, None, :]
-        k_s = geometry.scattered(ts[sl], ps[sl])[:, None, :]
-        h1 = _area_normals(rng, (k_i.shape[0], pairs), slope, distribution)
-        h2 = _area_normals(rng, (k_i.shape[0], pairs), slope, distribution)
-        w1 = np.clip(-dot(k_i, h1), 0.0, None) / h1[..., 2]
-        w2 = np.clip(dot(k_s, h2), 0.0, None) / h2[..., 2]
-        cos1, cos2 = np.clip(-dot(k_i, h1), 0.0, 1.0), np.clip(dot(k_s, h2), 0.0, 1.0)
-        k1, c1t, ok1 = geometry.refract(k_i, h1, n, cos1)
-        k2r, c2t, ok2 = geometry.refract(-k_s, h2, n, cos2)
-        k2 = -k2r
-        t1s, t1p, _ = fresnel.transmission_coefficients(cos1, n)
-        t2s, t2p, _ = fresnel.transmission_coefficients(cos2, n)
-        s1, _, p1 = _local_basis(np.broadcast_to(k_i, k1.shape), k1, h1)
-        s2, _, p2 = _local_basis(np.broadcast_to(k_s, k2.shape), k2, h2)
-        good = ok1 & ok2 & (k1[..., 2] < 0.0) & (k2[..., 2] > 0.0) & (cos1 > 0.0) & (cos2 > 0.0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            beam = np.where(good, n * c1t / cos1 * n * c2t / cos2, 0.0)
-        cos_sc = np.clip(dot(k1, k2), -1.0, 1.0)
-        m00 = jones_product_m00((t2s, t2p), ((dot(s2, s1), dot(s2, p1)), (dot(p2, s1), dot(p2, p1))), (t1s, t1p))
-        depth = np.abs(k1[..., 2]) + np.abs(k2[..., 2])
-        inv_depth = np.divide(1.0, depth, out=np.zeros_like(depth), where=depth > 0.0)
-        value = beam * phase.rayleigh_factor(cos_sc, g) * m00 * inv_depth / (n * n)
-        norm = np.sum(w1, axis=1) * np.sum(w2, axis=1) / pairs
-        with np.errstate(divide="ignore", invalid="ignore"):
-            out[sl] = np.where(norm > 0, np.sum(w1 * w2 * value, axis=1) / np.where(norm > 0, norm, 1.0), 0.0)
-    lit = (ti < np.pi / 2) & (ts < np.pi / 2)
-    return np.where(lit, out, 0.0).reshape(shape)
