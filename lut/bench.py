@@ -8,6 +8,7 @@ import time
 import numpy as np
 
 from . import models
+from .models import reference
 
 CLOSED_FORM = {
     "facet_reflection": (models.facet_reflection, {"n": 1.5, "slope": 0.3}),
@@ -99,7 +100,7 @@ def rough_time_vs_error(
             err = relative_rms(table.ravel()[pick], ref)
             rows.append({"model": "rough_single", "method": f"quadrature {nodes}", "seconds": t, "rms_error": err})
         for pairs in mc_pairs:
-            t, got = best_time(1, models.rough_single_random, si, ss, sp, g=0.3, pairs=pairs, seed=seed, **kw)
+            t, got = best_time(1, reference.rough_single_random, si, ss, sp, g=0.3, pairs=pairs, seed=seed, **kw)
             rows.append(
                 {
                     "model": "rough_single",

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from lut import models
+from lut.models import reference
 
 GOOD = {
     models.facet_reflection: {"n": 1.5, "slope": 0.3, "distribution": "gaussian"},
@@ -12,7 +13,7 @@ GOOD = {
     models.smooth_single: {"n": 1.5, "g": 0.3},
     models.rough_diffuse: {"n": 1.5, "rho": 0.5, "slope": 0.3, "distribution": "gaussian", "nodes": (4, 4)},
     models.rough_single: {"n": 1.5, "g": 0.3, "slope": 0.3, "distribution": "gaussian", "nodes": (4, 4)},
-    models.rough_single_random: {"n": 1.5, "g": 0.3, "slope": 0.3, "distribution": "gaussian", "pairs": 4},
+    reference.rough_single_random: {"n": 1.5, "g": 0.3, "slope": 0.3, "distribution": "gaussian", "pairs": 4},
 }
 
 BAD_PARAMS = [

@@ -2,12 +2,14 @@
 (T. A. Germer, "Polarized light diffusely scattered under smooth and rough
 interfaces"), as vectorized numpy functions returning Mueller BSDFs [sr⁻¹].
 
-See docs/models.md for conventions, deviations from the paper and accuracy."""
+See docs/models.md for conventions, deviations from the paper and accuracy.
+The paper's random-pairs method is kept apart, as a check, in
+``lut.models.reference``."""
 
 from .facet import facet_reflection, facet_transmission
 from .fresnel import internal_reflectance
 from .mueller import STOKES_45, jones_to_mueller, polarization_parameters
-from .rough import rough_diffuse, rough_internal_reflectance, rough_single, rough_single_random
+from .rough import rough_diffuse, rough_internal_reflectance, rough_single
 from .smooth import smooth_diffuse, smooth_single
 
 __all__ = [
@@ -20,7 +22,6 @@ __all__ = [
     "rough_diffuse",
     "rough_internal_reflectance",
     "rough_single",
-    "rough_single_random",
     "smooth_diffuse",
     "smooth_single",
 ]

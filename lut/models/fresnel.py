@@ -60,8 +60,17 @@ def transmission_coefficients(cos_i, n):
     return ts, tp, cos_t
 
 
-def _unpolarized_reflectance(c1, c2, n):
-    """½(|r_s|² + |r_p|²) from the cosines on the air (c1) and binder (c2) side."""
+def unpolarized_reflectance(c1, c2, n):
+    """Reflectance of unpolarized light, ½(|r_s|² + |r_p|²), at a planar
+    interface between air and index n: the integrand of paper Eq. 22.
+
+    ``c1`` and ``c2`` are the cosines of the angles to the normal on the air
+    and on the binder side, related by Snell's law (paper Eq. 9), so the same
+    value serves light arriving from either side (Stokes reciprocity:
+    |r| is the same both ways).  r_s and r_p are the Fresnel amplitude
+    coefficients written with both cosines, as in
+    ``reflection_coefficients`` (SCATMECH's ``Thin_Film_Transfer_Matrix``
+    with no film).  Real cosines only, i.e. not beyond the critical angle."""
     rs = (c1 - n * c2) / (c1 + n * c2)
     rp = (n * c1 - c2) / (n * c1 + c2)
     return 0.5 * (rs * rs + rp * rp)
@@ -92,8 +101,8 @@ def internal_reflectance(n: float, nodes: int = 256) -> float:
     if n > 1.0:
         c1 = w_
         c2 = np.sqrt(1.0 - (1.0 - c1 * c1) / (n * n))
-        integral = np.sum(weights * _unpolarized_reflectance(c1, c2, n) * 2.0 * c1)
+        integral = np.sum(weights * unpolarized_reflectance(c1, c2, n) * 2.0 * c1)
         return float((1.0 - 1.0 / (n * n)) + integral / (n * n))
     c2 = w_
     c1 = np.sqrt(1.0 - n * n * (1.0 - c2 * c2))
-    return float(np.sum(weights * _unpolarized_reflectance(c1, c2, n) * 2.0 * c2))
+    return float(np.sum(weights * unpolarized_reflectance(c1, c2, n) * 2.0 * c2))

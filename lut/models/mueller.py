@@ -51,6 +51,37 @@ def jones_to_mueller(jones: np.ndarray) -> np.ndarray:
     return m
 
 
+def jones_product_m00(exit_coefficients, v, entry_coefficients):
+    """M00 (the unpolarized element) of M(J) for the Jones product
+
+        J = diag(b_s, b_p) · V · diag(a_s, a_p),
+
+    a ray crossing one interface (amplitude coefficients a), projected by V
+    and crossing another (b).  M00 = ½ Σ_jk |J_jk|² (the [0, 0] element of
+    ``jones_to_mueller``; Bohren & Huffman), and with J_jk = b_j V_jk a_k
+
+        M00 = ½ [b_s² (V_ss² a_s² + V_sp² a_p²) + b_p² (V_ps² a_s² + V_pp² a_p²)].
+
+    This is the M00 of paper Eq. 13 (q_vol = diag(t_rs, t_rp) · V ·
+    diag(t_is, t_ip), V the projection dyadic of Eq. 4 between the internal
+    s/p vectors) and of its rough-interface counterpart, whose diagonal
+    matrices act in the facets' local s/p bases: rotating into the global
+    bases is orthogonal and leaves M00 unchanged.  Cheaper than building J
+    and calling ``jones_to_mueller`` when only M00 is wanted.
+
+    Parameters: ``exit_coefficients`` = (b_s, b_p); ``v`` = ((V_ss, V_sp),
+    (V_ps, V_pp)), rows (s_out, p_out) and columns (s_in, p_in) as for every
+    Jones matrix here; ``entry_coefficients`` = (a_s, a_p).  Real arrays that
+    broadcast together; returns their broadcast shape."""
+    b_s, b_p = exit_coefficients
+    (v_ss, v_sp), (v_ps, v_pp) = v
+    a_s, a_p = entry_coefficients
+    a_s2, a_p2 = a_s * a_s, a_p * a_p
+    return 0.5 * (
+        b_s * b_s * (v_ss * v_ss * a_s2 + v_sp * v_sp * a_p2) + b_p * b_p * (v_ps * v_ps * a_s2 + v_pp * v_pp * a_p2)
+    )
+
+
 def polarization_parameters(mueller: np.ndarray, stokes_in=STOKES_45) -> dict:
     """The paper's plotted quantities (Sec. 3) for a Mueller BRDF and an
     incident Stokes vector (default 45° linear, the paper's measurement).

@@ -5,6 +5,9 @@ facet normals per direction pair, one normal drawn for the incident ray and one
 for the scattered ray from the slope distribution as seen by that ray
 (Eq. 36).  Here the same average is computed by deterministic quadrature:
 
+The paper's random-pairs average itself is kept, as a check only, in
+``reference.rough_single_random``.
+
 * **Visible-normal rule.**  For a direction u (towards the source or the
   viewer) the facets it meets have density P(ζ) max(cos ι, 0) sec θn per
   dζx dζy (Eq. 36), normalized exactly (each ray meets one facet; the paper's
@@ -46,13 +49,14 @@ once, as in the paper.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 
 import numpy as np
 
 from . import _validate, distributions, fresnel, geometry, phase, smooth
 from .geometry import cross, dot
-from .mueller import jones_to_mueller
+from .mueller import jones_product_m00, jones_to_mueller
 
 #: Default (radial nodes per segment, azimuthal nodes) of the visible-normal
 #: rule; see docs/models.md for the error each reaches.
@@ -125,17 +129,55 @@ def visible_normals(theta, slope: float, distribution: str, nodes):
     return h, w
 
 
-def _facet_states(theta, n, slope, distribution, nodes, entering):
+@dataclasses.dataclass(frozen=True)
+class FacetState:
+    """The rays that cross the interface through the facets visible from one
+    external direction, for each polar angle θ of a batch (shape S) and each
+    of the M nodes of the visible-normal rule: what ``facet_states`` returns.
+
+    Vectors are unit vectors in the mean-surface frame (z along the mean
+    normal, out of the binder; x towards azimuth 0); every quantity is
+    dimensionless.  An entering ray comes from the source (azimuth π) and
+    refracts into the binder; an exiting one leaves the binder towards the
+    viewer at azimuth 0 (turn it about z for other azimuths)."""
+
+    #: (S, M, 3) facet unit normal, z component > 0 (mirrored to the source's
+    #: side on entry).
+    h: np.ndarray
+    #: (S, M) quadrature weight of the facet: its share of the area projected
+    #: along the ray, P(ζ) max(cos ι, 0) sec θn (Eq. 36), normalized to sum 1
+    #: over M; all 0 for θ >= π/2.
+    w: np.ndarray
+    #: (S, M, 3) external propagation direction: k_i (towards the surface) on
+    #: entry, k_s (away from it) on exit; the same for every facet.
+    k: np.ndarray
+    #: (S, M, 3) internal propagation direction from Snell's law at the facet
+    #: (Eq. 30): into the binder on entry; on exit the internal ray that
+    #: leaves through the facet along k.
+    k_in: np.ndarray
+    #: (S, M) Fresnel amplitude transmission coefficients for s and p light
+    #: from air at the facet's local angle ι (Eqs. 10, 11; on exit the
+    #: air-side ones, by reciprocity, Eq. 25); 0 where the facet is not met.
+    t_s: np.ndarray
+    t_p: np.ndarray
+    #: (S, M) beam factor n cos ι'/cos ι of the crossing (Eqs. 24, 42): the
+    #: Mueller transmittance is beam · M(diag(t_s, t_p)); 0 under total
+    #: internal reflection or where the facet is not met.
+    beam: np.ndarray
+
+
+def facet_states(theta, n, slope, distribution, nodes, entering) -> FacetState:
     """Rays crossing the interface through the facets visible from a
     direction at polar angle θ: entering the binder from the source
     (k_i, azimuth π) or, with ``entering=False``, leaving it towards the
     viewer (k_s at azimuth 0; rotate for other azimuths).
 
-    By reciprocity the exit is the entry of the reversed ray: the internal ray
-    is minus the refraction of -k_s, and the coefficients are the air-side
-    ones (paper Eqs. 11, 25).  Returns a dict of arrays (..., M): the facet
-    normal h, its weight w, the external propagation direction k, the internal
-    one k_in, t_s, t_p, and the beam factor n cos ι'/cos ι."""
+    The facets and their weights are the visible-normal rule (Eq. 36,
+    ``visible_normals``); the internal ray is Snell's law at each facet
+    (Eq. 30).  By reciprocity the exit is the entry of the reversed ray: the
+    internal ray is minus the refraction of -k_s, and the coefficients are
+    the air-side ones (paper Eqs. 11, 25).  See ``FacetState`` for the
+    arrays returned."""
     h, w = visible_normals(theta, slope, distribution, nodes)
     u = geometry.scattered(theta, 0.0)[..., None, :]  # towards the viewer or the source
     if entering:
@@ -146,7 +188,7 @@ def _facet_states(theta, n, slope, distribution, nodes, entering):
     t_s, t_p, _ = fresnel.transmission_coefficients(cos_i, n)
     beam = np.where(ok & (cos_i > 0.0), n * cos_t / np.where(cos_i > 0, cos_i, 1.0), 0.0)
     k = np.broadcast_to(-u if entering else u, h.shape)
-    return {"h": h, "w": w, "k": k, "k_in": k_down if entering else -k_down, "t_s": t_s, "t_p": t_p, "beam": beam}
+    return FacetState(h=h, w=w, k=k, k_in=k_down if entering else -k_down, t_s=t_s, t_p=t_p, beam=beam)
 
 
 # --------------------------------------------------------------------------- diffuse
@@ -154,13 +196,16 @@ def _facet_states(theta, n, slope, distribution, nodes, entering):
 
 def _transmittance_rows(theta, n, slope, distribution, nodes):
     """Facet-averaged first row of the entry transmittance Mueller matrix
-    (= first column of the exit one), shape (..., 4)."""
-    st = _facet_states(theta, n, slope, distribution, nodes, entering=True)
-    basis_a = geometry.sp_basis(st["k"])
-    basis_b = geometry.sp_basis(st["k_in"])
-    jones = geometry.interface_jones(st["k"], st["k_in"], st["h"], st["t_s"], st["t_p"], basis_a, basis_b)
+    (= first column of the exit one), shape (..., 4): Σ w · beam · M(J)[0, :]
+    over the facets, J the facet's transmission Jones matrix between the
+    global s/p bases of the external and the internal ray (Eq. 40), beam the
+    factor of Eq. 42 (the rough counterpart of Eq. 24)."""
+    facets = facet_states(theta, n, slope, distribution, nodes, entering=True)
+    basis_a = geometry.sp_basis(facets.k)
+    basis_b = geometry.sp_basis(facets.k_in)
+    jones = geometry.interface_jones(facets.k, facets.k_in, facets.h, facets.t_s, facets.t_p, basis_a, basis_b)
     m = jones_to_mueller(jones)[..., 0, :]
-    return np.sum((st["w"] * st["beam"])[..., None] * m, axis=-2)
+    return np.sum((facets.w * facets.beam)[..., None] * m, axis=-2)
 
 
 @functools.lru_cache(maxsize=64)
@@ -242,22 +287,68 @@ def rough_diffuse(
 # --------------------------------------------------------------------------- single
 
 
-def _local_basis(k_ext, k_int, h):
+def local_basis(k_ext, k_int, h):
     """Local s vector of the facet and the p vectors of the external and the
-    internal ray (paper Eq. 40); the s vector falls back to the global one at
-    normal incidence on the facet, where the choice does not matter."""
+    internal ray (paper Eq. 40): s' = k×h/|k×h|, p' = k×s'.  The s vector
+    falls back to the global one at normal incidence on the facet, where the
+    choice does not matter."""
     s_glob, _ = geometry.sp_basis(k_ext)
     s_loc, _ = geometry.unit_or(cross(k_ext, h), s_glob)
     return s_loc, cross(k_ext, s_loc), cross(k_int, s_loc)
 
 
 def _rotate_z(v, cos_p, sin_p):
+    """Vectors v (..., 3) turned about z by the angle with cosine ``cos_p``
+    and sine ``sin_p``."""
     x, y = v[..., 0], v[..., 1]
     return np.stack((x * cos_p - y * sin_p, x * sin_p + y * cos_p, v[..., 2]), axis=-1)
 
 
-def _gather(states, index):
-    return {key: val[index] for key, val in states.items()}
+@dataclasses.dataclass(frozen=True)
+class ScatterLeg:
+    """One leg of the single-scatter sum, entry or exit: per facet of the
+    visible-normal rule, what the pair sum needs.  Built by ``_scatter_leg``
+    from a ``FacetState``; shapes (S, M) for S polar angles and M facets,
+    with a trailing (3,) for vectors (mean-surface frame, unit, as in
+    ``FacetState``) and (2, 2) for the Jones matrix.  Dimensionless."""
+
+    #: Facet weight times beam factor, w · n cos ι'/cos ι (Eqs. 36, 42); 0 for
+    #: rays whose internal direction does not head into (entry) or out of
+    #: (exit) the bulk.
+    weight: np.ndarray
+    #: |cos θ'| of the internal ray to the mean normal: depth is measured
+    #: along it, as cos θ'i and cos θ'r in Eqs. 18-19.
+    depth: np.ndarray
+    #: Internal propagation direction (``FacetState.k_in``).
+    k_in: np.ndarray
+    #: The facet's local s vector, k×h/|k×h| (Eq. 40).
+    s: np.ndarray
+    #: The internal ray's local p vector, k_in×s (Eq. 40).
+    p: np.ndarray
+    #: Air-side Fresnel amplitude transmission coefficients (``FacetState``).
+    t_s: np.ndarray
+    t_p: np.ndarray
+    #: Jones matrix of the crossing between the external ray's global s/p
+    #: basis and the facet's internal local one (s, p): Eq. 40 without its
+    #: rotation out of the local basis, A = diag(t_s, t_p)·R on entry; on
+    #: exit its transpose B = Rᵀ·diag(t_s, t_p).
+    jones: np.ndarray
+
+    def take(self, index) -> ScatterLeg:
+        """The legs at the angle indices ``index`` (C,): shapes (C, M, ...)."""
+        return ScatterLeg(**{f.name: getattr(self, f.name)[index] for f in dataclasses.fields(self)})
+
+    def rotated(self, cos_p, sin_p) -> ScatterLeg:
+        """The leg turned about the mean normal by φ (cosine and sine of
+        shape (C, 1)).  The Jones matrix is unchanged: the exit ray's global
+        basis turns rigidly with the facets, at θs = 0 as well (the limit
+        along φs, as for every model; docs/models.md, Conventions)."""
+        return dataclasses.replace(
+            self,
+            k_in=_rotate_z(self.k_in, cos_p, sin_p),
+            s=_rotate_z(self.s, cos_p, sin_p),
+            p=_rotate_z(self.p, cos_p, sin_p),
+        )
 
 
 def rough_single(theta_i, theta_s, phi_s, *, n, g, slope, distribution="gaussian", mueller=True, nodes=SINGLE_NODES):
@@ -278,141 +369,127 @@ def rough_single(theta_i, theta_s, phi_s, *, n, g, slope, distribution="gaussian
     return _single_sum(ti, ts, ps, n, g, slope, distribution, nodes, nodes, mueller)
 
 
-def _prepare(theta, n, slope, distribution, nodes, entering):
-    """Facet states for the single-scatter sum: weights (zero for rays that
-    do not head into, respectively out of, the bulk), depths |cos θ'|, the
-    internal local s/p vectors, and the Jones matrix of the crossing between
-    the ray's global s/p basis and the facet's internal one: A = diag(t_s,
-    t_p)·R on entry; on exit its transpose, B = Rᵀ·diag(t_s, t_p)."""
-    st = _facet_states(theta, n, slope, distribution, nodes, entering)
-    s_loc, _, p_int = _local_basis(st["k"], st["k_in"], st["h"])
-    heading = st["k_in"][..., 2] < 0.0 if entering else st["k_in"][..., 2] > 0.0
-    st["weight"] = np.where(heading, st["w"] * st["beam"], 0.0)
-    st["depth"] = np.abs(st["k_in"][..., 2])
-    st["s"], st["p"] = s_loc, p_int
-    # The crossing seen from the global s/p basis of k into the facet's own
-    # internal basis (R_out = identity): diag(t_s, t_p)·R.
-    jones = geometry.interface_jones(
-        st["k"], st["k_in"], st["h"], st["t_s"], st["t_p"], geometry.sp_basis(st["k"]), (s_loc, p_int)
-    )
-    # Computed at φs = 0; the exit's global basis turns rigidly with the
-    # azimuth (at θs = 0 as well: s = ŷ is the limit along φs = 0).
-    st["J"] = jones if entering else np.swapaxes(jones, -1, -2)
-    return st
-
-
 def _single_sum(ti, ts, ps, n, g, slope, distribution, nodes_in, nodes_out, mueller):
+    """The single-scatter sum of the module docstring over all entry × exit
+    facet pairs, for flat or broadcast angle arrays (validated, same shape).
+    Evaluated in chunks of direction pairs (``CHUNK_PAIRS`` facet pairs)."""
     shape = ti.shape
     ti, ts, ps = ti.ravel(), ts.ravel(), ps.ravel()
+
+    # Computing the entry facets at the distinct incident angles and the exit
+    # facets at the distinct scattering angles (at φs = 0).
     ui, inv_i = np.unique(ti, return_inverse=True)
     us, inv_s = np.unique(ts, return_inverse=True)
-    entry = _prepare(ui, n, slope, distribution, nodes_in, entering=True)
-    exit_ = _prepare(us, n, slope, distribution, nodes_out, entering=False)
-    m_in, m_out = entry["w"].shape[-1], exit_["w"].shape[-1]
-    lit = (ti < np.pi / 2) & (ts < np.pi / 2)
+    entry = _scatter_leg(ui, n, slope, distribution, nodes_in, entering=True)
+    exit_ = _scatter_leg(us, n, slope, distribution, nodes_out, entering=False)
+
     out = np.zeros(ti.shape + ((4, 4) if mueller else ()))
-    chunk = max(1, CHUNK_PAIRS // (m_in * m_out))
+    chunk = max(1, CHUNK_PAIRS // (entry.weight.shape[-1] * exit_.weight.shape[-1]))
     for start in range(0, ti.size, chunk):
         sl = slice(start, start + chunk)
-        a = _gather(entry, inv_i[sl])
-        b = _gather(exit_, inv_s[sl])
-        cp, sp = np.cos(ps[sl])[:, None], np.sin(ps[sl])[:, None]
-        k2, s2, p2 = (_rotate_z(b[key], cp, sp) for key in ("k_in", "s", "p"))
-        # All pairwise dot products in one batched matrix product.
-        left = np.concatenate((a["k_in"], a["s"], a["p"]), axis=1)  # (C, 3M, 3)
-        right = np.concatenate((k2, s2, p2), axis=1)  # (C, 3N, 3)
-        d = np.matmul(left, right.transpose(0, 2, 1)).reshape(-1, 3, m_in, 3, m_out)
-        cos_sc = np.clip(d[:, 0, :, 0, :], -1.0, 1.0)
-        v_ss, v_sp = d[:, 1, :, 1, :], d[:, 2, :, 1, :]
-        v_ps, v_pp = d[:, 1, :, 2, :], d[:, 2, :, 2, :]
-        depth = a["depth"][:, :, None] + b["depth"][:, None, :]
-        # Eq. 19: 1/(cos θ'1 + cos θ'2); both cosines vanish only for grazing
-        # internal rays, whose weights are already zero.
-        inv_depth = np.divide(1.0, depth, out=np.zeros_like(depth), where=depth > 0.0)
-        weight = (
-            a["weight"][:, :, None] * b["weight"][:, None, :] * phase.rayleigh_factor(cos_sc, g) * inv_depth / (n * n)
-        )
-        if not mueller:
-            t1s, t1p = (a[key][:, :, None] ** 2 for key in ("t_s", "t_p"))
-            t2s, t2p = (b[key][:, None, :] ** 2 for key in ("t_s", "t_p"))
-            m00 = 0.5 * (t2s * (v_ss**2 * t1s + v_sp**2 * t1p) + t2p * (v_ps**2 * t1s + v_pp**2 * t1p))
-            out[sl] = np.sum(weight * m00, axis=(1, 2))
-            continue
-        v = np.stack((np.stack((v_ss, v_sp), -1), np.stack((v_ps, v_pp), -1)), -2)
-        # Rotating the exit states by φs leaves B unchanged: the exit ray's
-        # global basis turns rigidly with them, at θs = 0 too (the limit along
-        # φs, as for every model; docs/models.md, Conventions).
-        jones = np.matmul(np.matmul(b["J"][:, None, :, :, :], v), a["J"][:, :, None, :, :])
-        out[sl] = np.sum(weight[..., None, None] * jones_to_mueller(jones), axis=(1, 2))
+        # Gathering the legs of each direction pair, the exit turned to φs.
+        a = entry.take(inv_i[sl])
+        b = exit_.take(inv_s[sl]).rotated(np.cos(ps[sl])[:, None], np.sin(ps[sl])[:, None])
+
+        # Computing the scattering angle and the projection dyadic of every
+        # facet pair.
+        cos_sc, v = _pair_geometry(a, b)
+
+        # Computing the scalar weight of every facet pair.
+        weight = _pair_weights(a, b, cos_sc, g, n)
+
+        # Computing the Mueller matrix (or its M00) of every facet pair and
+        # summing over the pairs.
+        if mueller:
+            out[sl] = np.sum(weight[..., None, None] * _pair_mueller(a, b, v), axis=(1, 2))
+        else:
+            out[sl] = np.sum(weight * _pair_m00(a, b, v), axis=(1, 2))
+
+    # No light reaches or leaves the binder at or below the horizon.
+    lit = (ti < np.pi / 2) & (ts < np.pi / 2)
     out[~lit] = 0.0
     return out.reshape(shape + ((4, 4) if mueller else ()))
 
 
-# --------------------------------------------------------------------------- paper's method
+def _scatter_leg(theta, n, slope, distribution, nodes, entering) -> ScatterLeg:
+    """The entry (or, with ``entering=False``, exit) leg at polar angles θ:
+    the facets of ``facet_states``, their local s/p vectors (Eq. 40), the
+    depth cosines of Eq. 19, and the Jones matrix of each crossing between
+    the ray's global s/p basis and the facet's internal one (Eq. 40 with the
+    Fresnel coefficients of Eq. 10, or Eq. 11 by reciprocity on exit)."""
+    facets = facet_states(theta, n, slope, distribution, nodes, entering)
+    s_loc, _, p_int = local_basis(facets.k, facets.k_in, facets.h)
+    heading = facets.k_in[..., 2] < 0.0 if entering else facets.k_in[..., 2] > 0.0
+    # The crossing seen from the global s/p basis of k into the facet's own
+    # internal basis (R_out = identity): diag(t_s, t_p)·R.
+    jones = geometry.interface_jones(
+        facets.k, facets.k_in, facets.h, facets.t_s, facets.t_p, geometry.sp_basis(facets.k), (s_loc, p_int)
+    )
+    return ScatterLeg(
+        weight=np.where(heading, facets.w * facets.beam, 0.0),
+        depth=np.abs(facets.k_in[..., 2]),
+        k_in=facets.k_in,
+        s=s_loc,
+        p=p_int,
+        t_s=facets.t_s,
+        t_p=facets.t_p,
+        # Computed at φs = 0; the exit's global basis turns rigidly with the
+        # azimuth (``ScatterLeg.rotated``).
+        jones=jones if entering else np.swapaxes(jones, -1, -2),
+    )
 
 
-def _area_normals(rng, shape, slope, distribution):
-    """Random facet normals distributed as P(ζ) dζx dζy (uniform on the mean
-    plane), the paper's first random surface-normal generator."""
-    if distribution == "gaussian":
-        zeta = slope * np.sqrt(rng.standard_exponential(shape))
-    else:
-        zeta = slope * rng.standard_gamma(2.0, shape) / distributions.SQRT6
-    phi = rng.uniform(-np.pi, np.pi, shape)
-    norm = np.sqrt(1.0 + zeta * zeta)
-    return np.stack((zeta * np.cos(phi) / norm, zeta * np.sin(phi) / norm, 1.0 / norm), axis=-1)
+def _pair_geometry(a: ScatterLeg, b: ScatterLeg):
+    """Every entry facet a against every exit facet b, from their internal
+    vectors: cos θ_ab = k'_a·k'_b, the cosine of the scattering angle of the
+    phase function (Eqs. 2, 7), and V_ab, the projection dyadic of Eq. 4
+    between the facets' internal local s/p vectors (as in Eq. 13): V_jk =
+    e_b,j · (σ₂σ₂ + π₂π₂) · e_a,k = e_b,j · e_a,k, since e_b,j ⊥ k'_b lies in
+    the span of σ₂ and π₂.  Returns cos θ (C, M, N) and ((V_ss, V_sp),
+    (V_ps, V_pp)), rows (s_b, p_b), columns (s_a, p_a)."""
+    m_in, m_out = a.weight.shape[-1], b.weight.shape[-1]
+    # All pairwise dot products in one batched matrix product.
+    left = np.concatenate((a.k_in, a.s, a.p), axis=1)  # (C, 3M, 3)
+    right = np.concatenate((b.k_in, b.s, b.p), axis=1)  # (C, 3N, 3)
+    d = np.matmul(left, right.transpose(0, 2, 1)).reshape(-1, 3, m_in, 3, m_out)
+    cos_sc = np.clip(d[:, 0, :, 0, :], -1.0, 1.0)
+    v_ss, v_sp = d[:, 1, :, 1, :], d[:, 2, :, 1, :]
+    v_ps, v_pp = d[:, 1, :, 2, :], d[:, 2, :, 2, :]
+    return cos_sc, ((v_ss, v_sp), (v_ps, v_pp))
 
 
-def rough_single_random(theta_i, theta_s, phi_s, *, n, g, slope, distribution="gaussian", pairs=5000, seed=0):
-    """M00 of ``rough_single`` by the paper's Monte Carlo method (Sec. 2.5):
-    for every direction pair, ``pairs`` independent pairs of random facet
-    normals, one met by the incident and one by the scattered ray, averaged.
-    Kept as the baseline of the benchmark (scripts/benchmark_models.py); the
-    quadrature of ``rough_single`` is the production path.
+def _pair_weights(a: ScatterLeg, b: ScatterLeg, cos_sc, g, n):
+    """The scalar factor of every pair (C, M, N), Eq. 20 written with the
+    beam factors T = n cos θ'/cos θ of Eqs. 24-25 (T_a T_b / n² =
+    cos θ'i cos θ'r / (cos θi cos θr)) and taken facet by facet:
 
-    The normals seen by a ray are drawn from the area distribution and
-    weighted by their projected area max(cos ι, 0) sec θn (Eq. 36) with a
-    self-normalized average, rather than by the paper's rejection step;
-    both sample the same distribution."""
-    n = _validate.index(n)
-    g = _validate.asymmetry(g)
-    slope = _validate.rms_slope(slope)
-    distribution = _validate.distribution(distribution)
-    pairs = _validate.positive_int(pairs, "pairs")
-    ti, ts, ps = (a.ravel() for a in _validate.angles(theta_i, theta_s, phi_s))
-    shape = np.broadcast(theta_i, theta_s, phi_s).shape
-    rng = np.random.default_rng(seed)
-    out = np.zeros(ti.shape)
-    chunk = max(1, CHUNK_PAIRS // pairs)
-    for start in range(0, ti.size, chunk):
-        sl = slice(start, start + chunk)
-        k_i = geometry.incident(ti[sl])[:, None, :]
-        k_s = geometry.scattered(ts[sl], ps[sl])[:, None, :]
-        h1 = _area_normals(rng, (k_i.shape[0], pairs), slope, distribution)
-        h2 = _area_normals(rng, (k_i.shape[0], pairs), slope, distribution)
-        w1 = np.clip(-dot(k_i, h1), 0.0, None) / h1[..., 2]
-        w2 = np.clip(dot(k_s, h2), 0.0, None) / h2[..., 2]
-        cos1, cos2 = np.clip(-dot(k_i, h1), 0.0, 1.0), np.clip(dot(k_s, h2), 0.0, 1.0)
-        k1, c1t, ok1 = geometry.refract(k_i, h1, n, cos1)
-        k2r, c2t, ok2 = geometry.refract(-k_s, h2, n, cos2)
-        k2 = -k2r
-        t1s, t1p, _ = fresnel.transmission_coefficients(cos1, n)
-        t2s, t2p, _ = fresnel.transmission_coefficients(cos2, n)
-        s1, _, p1 = _local_basis(np.broadcast_to(k_i, k1.shape), k1, h1)
-        s2, _, p2 = _local_basis(np.broadcast_to(k_s, k2.shape), k2, h2)
-        good = ok1 & ok2 & (k1[..., 2] < 0.0) & (k2[..., 2] > 0.0) & (cos1 > 0.0) & (cos2 > 0.0)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            beam = np.where(good, n * c1t / cos1 * n * c2t / cos2, 0.0)
-        cos_sc = np.clip(dot(k1, k2), -1.0, 1.0)
-        m00 = 0.5 * (
-            t2s**2 * (dot(s2, s1) ** 2 * t1s**2 + dot(s2, p1) ** 2 * t1p**2)
-            + t2p**2 * (dot(p2, s1) ** 2 * t1s**2 + dot(p2, p1) ** 2 * t1p**2)
-        )
-        depth = np.abs(k1[..., 2]) + np.abs(k2[..., 2])
-        inv_depth = np.divide(1.0, depth, out=np.zeros_like(depth), where=depth > 0.0)
-        value = beam * phase.rayleigh_factor(cos_sc, g) * m00 * inv_depth / (n * n)
-        norm = np.sum(w1, axis=1) * np.sum(w2, axis=1) / pairs
-        with np.errstate(divide="ignore", invalid="ignore"):
-            out[sl] = np.where(norm > 0, np.sum(w1 * w2 * value, axis=1) / np.where(norm > 0, norm, 1.0), 0.0)
-    lit = (ti < np.pi / 2) & (ts < np.pi / 2)
-    return np.where(lit, out, 0.0).reshape(shape)
+        w_a w_b · (T_a T_b / n²) · 2p(θ_ab) / (1 + cos²θ_ab) / (|cos θ'_a| + |cos θ'_b|),
+
+    the phase factor 2p/(1 + cos²θ) of Eq. 7 and the depth integral
+    1/(cos θ'i + cos θ'r) of Eq. 19."""
+    depth = a.depth[:, :, None] + b.depth[:, None, :]
+    # Eq. 19: 1/(cos θ'1 + cos θ'2); both cosines vanish only for grazing
+    # internal rays, whose weights are already zero.
+    inv_depth = np.divide(1.0, depth, out=np.zeros_like(depth), where=depth > 0.0)
+    return a.weight[:, :, None] * b.weight[:, None, :] * phase.rayleigh_factor(cos_sc, g) * inv_depth / (n * n)
+
+
+def _pair_m00(a: ScatterLeg, b: ScatterLeg, v):
+    """M00 of M(J_b V_ab J_a) for every pair (C, M, N) (Eqs. 13-14): the
+    rotations of J_a and J_b into the global bases leave M00 unchanged, so
+    only the facets' Fresnel coefficients enter (``jones_product_m00``)."""
+    return jones_product_m00(
+        (b.t_s[:, None, :], b.t_p[:, None, :]),
+        v,
+        (a.t_s[:, :, None], a.t_p[:, :, None]),
+    )
+
+
+def _pair_mueller(a: ScatterLeg, b: ScatterLeg, v):
+    """M(J_b V_ab J_a) for every pair (C, M, N, 4, 4): the Mueller matrix of
+    the net Jones matrix in the global s/p bases of the incident and the
+    scattered ray (Eqs. 12-14, with the facet crossings of Eq. 40)."""
+    (v_ss, v_sp), (v_ps, v_pp) = v
+    v_matrix = np.stack((np.stack((v_ss, v_sp), -1), np.stack((v_ps, v_pp), -1)), -2)
+    jones = np.matmul(np.matmul(b.jones[:, None, :, :, :], v_matrix), a.jones[:, :, None, :, :])
+    return jones_to_mueller(jones)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import _validate, _vectorize, fresnel, phase
-from .mueller import jones_to_mueller
+from .mueller import jones_product_m00, jones_to_mueller
 
 
 def _refracted_cosines(cos_i, sin_i, up_i, cos_s, sin_s, up_s, n):
@@ -105,11 +105,7 @@ def smooth_single(theta_i, theta_s, phi_s, *, n, g, mueller=True):
         v_ss, v_sp = cb, -sb * cos_ip
         v_ps, v_pp = -sb * cos_sp, sin_ip * sin_sp - cos_ip * cos_sp * cb
         if not want_mueller:
-            tis2, tip2 = tis * tis, tip * tip
-            m00 = trs * trs * (v_ss * v_ss * tis2 + v_sp * v_sp * tip2) + trp * trp * (
-                v_ps * v_ps * tis2 + v_pp * v_pp * tip2
-            )
-            return 0.5 * scale * m00
+            return scale * jones_product_m00((trs, trp), ((v_ss, v_sp), (v_ps, v_pp)), (tis, tip))
         jones = np.empty(scale.shape + (2, 2))
         jones[:, 0, 0] = trs * v_ss * tis
         jones[:, 0, 1] = trs * v_sp * tip
