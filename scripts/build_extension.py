@@ -9,7 +9,7 @@ wheels into the extensions' shared site-packages, where another extension's
 top-level ``lut`` could clash with ours, so the wheel's package is the
 repository's ``lut`` renamed ``paint_lut_core`` (its imports are relative);
 the add-on imports it through addon/_lut.py.  The development-only modules
-(``DEV_ONLY``: plots and benchmarks) are left out.
+(``DEV_ONLY``: plots, benchmarks and the models' reference method) are left out.
 
 The one wheel is pure Python and serves Linux, Windows and macOS alike: at run
 time lut needs only numpy and OpenImageIO, which Blender 5.0 ships, and its
@@ -42,7 +42,7 @@ PACKAGE = "paint_lut_core"
 
 #: lut modules the wheel leaves out: matplotlib plots (figures, and examples,
 #: which draws them) and benchmarks; the CLI's ``example`` command says so.
-DEV_ONLY = ("bench.py", "examples.py", "figures.py")
+DEV_ONLY = ("bench.py", "examples.py", "figures.py", "models/reference.py")
 
 #: zip entries get this fixed time, so the same sources give the same wheel.
 EPOCH = (1980, 1, 1, 0, 0, 0)
