@@ -174,7 +174,7 @@ def test_bad_paint_files_name_the_file_and_the_parameter(content, message, tmp_p
 def test_a_spectrum_in_micrometres_is_refused_not_flat_grey():
     with pytest.raises(ValueError, match="must be in nm"):
         lut.Spectrum([0.38, 0.5, 0.78], [0.1, 0.5, 0.9])
-    with pytest.raises(ValueError, match="scale must be a finite number >= 0, got nan"):
+    with pytest.raises(ValueError, match="scale must be a finite real number >= 0, got nan"):
         lut.Spectrum([400, 700], [0.1, 0.9], scale=float("nan"))
 
 
