@@ -138,7 +138,7 @@ def _error_line(capsys):
         (["--resolution", "4096", "4096", "4096"], "product N_u*N_theta_d*N_phi_d of at most 4194304"),
         (["--resolution", "1024", "1024", "8"], "got 1024 1024 8 (8388608 nodes)"),
         (["--single-nodes", "1000", "1000"], "--single-nodes must be two whole numbers in [1, 64]"),
-        (["--n", "1e6"], "n must be in [1, 4], got 1e+06"),
+        (["--n", "1e6"], "n must be in [1, 4], got 1000000.0"),
         (["--slope", "1e300"], "slope must be 0 (smooth) or in [0.001, 3], got 1e+300"),
         (["--slope", "1e-20"], "slope must be 0 (smooth) or in [0.001, 3], got 1e-20"),
     ],
