@@ -504,3 +504,35 @@ def test_a_paint_beyond_a_materials_limits_is_refused_naming_them(addon_register
         with pytest.raises(ValueError, match=f"^{name} must be {limits.text(name)}".replace("[", r"\[")):
             validation.check_paint_fits(paint, paint.space)
         validation.check_paint_fits(lut.Paint(**{name: limits.high}), paint.space)
+
+
+class _Layout:
+    """Records the properties a panel draws."""
+
+    def __init__(self):
+        self.props = []
+
+    def prop(self, data, name):
+        assert name in data.bl_rna.properties, name
+        self.props.append(name)
+
+    def column(self, **_):
+        return self
+
+    row = column
+
+    def label(self, **_):
+        pass
+
+    def operator(self, *_, **__):
+        pass
+
+
+def test_the_panel_shows_every_material_field_colours_first(material):
+    from addon import panels, properties
+
+    layout = _Layout()
+    panels.draw_settings(layout, material)
+    fields = [spec.name for spec in properties.MATERIAL_FIELDS]
+    assert [p for p in layout.props if p in fields] == ["rho", "single", "facet", "n", "g", "slope", "distribution"]
+    assert layout.props[:3] == ["enabled", "preset", "seen"]
