@@ -2,10 +2,11 @@
 
 A property for every ``lut.Paint`` field a material stores, made from its
 description in ``lut.schema.PAINT_FIELDS`` (name, limits, slider, tooltip,
-default), plus the preset, the baked LUT's path and a stale flag.  Choosing a preset fills the fields with the
-preset's values (its spectral colours shown as RGB in the scene's working
-space) and bakes use the preset's exact spectral paint; editing any physical
-field afterwards makes the paint "Custom".  Other spectral paints are stored
+default), plus the preset, the baked LUT's path and a stale flag.
+Choosing a preset fills the fields with the preset's values (its spectral
+colours shown as RGB in the scene's working space) and bakes use the
+preset's exact spectral paint; editing any physical field afterwards makes
+the paint "Custom".  Other spectral paints are stored
 whole (``spectral_paint``, JSON) under the "Spectral" preset."""
 
 from __future__ import annotations
