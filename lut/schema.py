@@ -25,7 +25,7 @@ from typing import Any
 
 from . import colour_management as cm
 from .models import _validate
-from .models._validate import Range, check_range, range_error  # noqa: F401  (one import for the add-on)
+from .models._validate import Range, check_range, range_error  # noqa: F401  (the command line's and add-on's)
 
 #: The kinds of field: how a value is given, checked, shown and stored.
 #: ``index`` a number, or Cauchy coefficients in a spectral paint;
@@ -109,7 +109,7 @@ class FieldSpec:
         return str(value) if value else "''"
 
     def allowed_text(self) -> str:
-        """What the field accepts, in notation: "(0, ∞)" written "> 0", "[0, 1]", or the choices."""
+        """What the field accepts: an interval ("[0, 1]", "> 0") or the choices."""
         if self.choices:
             return ", ".join(f"`{c}`" for c in self.choices)
         return self.allowed.interval() if self.allowed else ""
