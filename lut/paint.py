@@ -72,24 +72,27 @@ def _internal_reflectance(n, slope, distribution, diffuse_nodes):
 
 
 def _colour_value(value, name: str):
-    """An RGB triple (or a grey scalar) in [0, 1], or a Spectrum (given as
-    one, as a dataset name or .csv path, or as a dict; see Paint.from_dict)."""
+    """An RGB triple (or a grey scalar) in the field's range ([0, 1]), or a
+    Spectrum (given as one, as a dataset name or .csv path, or as a dict; see
+    Paint.from_dict)."""
+    spec = PAINT_FIELDS[name]
+    within = spec.allowed.text(name)
     if isinstance(value, (str, dict)):
         value = _colour_from_json(value, name)
     if isinstance(value, cm.Spectrum):
-        if np.any(value.values < 0) or np.any(value.values > 1):
-            raise ValueError(f"{name} spectrum must lie in [0, 1] at every wavelength")
+        if not all(spec.allowed.contains(float(v)) for v in value.values):
+            raise ValueError(f"{name} spectrum must lie {within} at every wavelength")
         return value
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         value = (value, value, value)
     try:
         triple = tuple(float(v) for v in value)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be an RGB triple of numbers in [0, 1], a grey number or a Spectrum") from None
+        raise ValueError(f"{name} must be an RGB triple of numbers {within}, a grey number or a Spectrum") from None
     if len(triple) != 3:
-        raise ValueError(f"{name} must be an RGB triple of numbers in [0, 1], got {len(triple)} values")
+        raise ValueError(f"{name} must be an RGB triple of numbers {within}, got {len(triple)} values")
     for v in triple:
-        PAINT_FIELDS[name].check(v)
+        spec.check(v)
     return triple
 
 
