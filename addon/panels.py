@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import bpy
 
+from .properties import MATERIAL_FIELDS
+
 
 def draw_settings(layout, material):
     settings = material.paint_lut
@@ -14,14 +16,13 @@ def draw_settings(layout, material):
     col.use_property_decorate = False
     col.label(text="Colours (live: no bake)")
     col.prop(settings, "seen")
-    col.prop(settings, "rho")
-    col.prop(settings, "single")
-    col.prop(settings, "facet")
+    for spec in MATERIAL_FIELDS:  # the colours and weights (lut.schema)
+        if not spec.shapes_type:
+            col.prop(settings, spec.name)
     col.label(text="Paint type (bake)")
-    col.prop(settings, "n")
-    col.prop(settings, "g")
-    col.prop(settings, "slope")
-    col.prop(settings, "distribution")
+    for spec in MATERIAL_FIELDS:
+        if spec.shapes_type:
+            col.prop(settings, spec.name)
     row = layout.row()
     row.operator("paint_lut.bake", icon="RENDER_STILL")
     if settings.stale:

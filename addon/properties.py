@@ -1,10 +1,12 @@
 """The paint settings stored on every material: ``material.paint_lut``.
 
-Every ``lut.Paint`` field, with the same limits, plus the preset, the baked
-LUT's path and a stale flag.  Choosing a preset fills the fields with the
-preset's values (its spectral colours shown as RGB in the scene's working
-space) and bakes use the preset's exact spectral paint; editing any physical
-field afterwards makes the paint "Custom".  Other spectral paints are stored
+A property for every ``lut.Paint`` field a material stores, made from its
+description in ``lut.schema.PAINT_FIELDS`` (name, limits, slider, tooltip,
+default), plus the preset, the baked LUT's path and a stale flag.
+Choosing a preset fills the fields with the preset's values (its spectral
+colours shown as RGB in the scene's working space) and bakes use the
+preset's exact spectral paint; editing any physical field afterwards makes
+the paint "Custom".  Other spectral paints are stored
 whole (``spectral_paint``, JSON) under the "Spectral" preset."""
 
 from __future__ import annotations
@@ -15,7 +17,10 @@ import json
 
 import bpy
 
-from ._lut import lut
+from ._lut import lut, schema
+
+#: The paint fields a material stores (in ``lut.Paint``'s order).
+MATERIAL_FIELDS = tuple(spec for spec in schema.PAINT_FIELDS.values() if spec.on_material)
 
 PRESET_ITEMS = [
     ("CUSTOM", "Custom", "Paint given by the fields below"),
@@ -86,13 +91,16 @@ def set_fields(settings, paint: lut.Paint) -> None:
     _applying_preset = True
     try:
         values = node_inputs(paint)
-        settings.n = float(paint.index_at(lut.paint.REFERENCE_WAVELENGTH))  # a dispersive n at the sodium D line
-        settings.rho = values["Pigment Color"]
-        settings.single = values["Single Scattering Color"]
-        settings.g = paint.g
-        settings.slope = paint.slope
-        settings.distribution = paint.distribution.upper()
-        settings.facet = values["Surface Reflection"]
+        for spec in MATERIAL_FIELDS:
+            if spec.kind == "index":  # a dispersive n at the sodium D line
+                value = float(paint.index_at(lut.paint.REFERENCE_WAVELENGTH))
+            elif spec.label in values:  # colours and the facet weight: the node group's inputs that render them
+                value = values[spec.label]
+            elif spec.kind == "choice":
+                value = getattr(paint, spec.name).upper()
+            else:
+                value = getattr(paint, spec.name)
+            setattr(settings, spec.name, value)
     finally:
         _applying_preset = False
 
@@ -146,39 +154,6 @@ class PaintLUTSettings(bpy.types.PropertyGroup):
         name="Preset", items=PRESET_ITEMS, default="CUSTOM", update=_preset_changed,
         description="One of the paper's three paints, or Custom",
     )  # fmt: skip
-    n: bpy.props.FloatProperty(
-        name="Index", default=1.5, min=1.0, soft_max=2.0, max=4.0, precision=3, update=_type_changed,
-        description="Refractive index of the binder",
-    )  # fmt: skip
-    rho: bpy.props.FloatVectorProperty(
-        name="Pigment Color", subtype="COLOR", size=3, default=(0.8, 0.8, 0.8), min=0.0, max=1.0,
-        update=_colour_changed,
-        description="Reflectance rho of the multiply scattering pigment under the binder (scene-linear RGB); "
-        "changes render at once, no bake",
-    )  # fmt: skip
-    single: bpy.props.FloatVectorProperty(
-        name="Single Scattering Color", subtype="COLOR", size=3, default=(0.0, 0.0, 0.0), min=0.0, max=1.0,
-        update=_colour_changed,
-        description="Albedo of single scattering by pigment particles under the surface; changes render at once",
-    )  # fmt: skip
-    g: bpy.props.FloatProperty(
-        name="Anisotropy", default=0.0, min=-0.99, max=0.99, update=_type_changed,
-        description="Henyey-Greenstein asymmetry of single scattering (positive: forward)",
-    )  # fmt: skip
-    slope: bpy.props.FloatProperty(
-        name="Roughness Slope", default=0.0, min=0.0, soft_max=1.0, max=3.0, precision=3, update=_type_changed,
-        description="RMS slope of the surface (0: smooth, glossy; 2: very matte)",
-    )  # fmt: skip
-    distribution: bpy.props.EnumProperty(
-        name="Slopes",
-        items=[("GAUSSIAN", "Gaussian", "Gaussian slope distribution"),
-               ("EXPONENTIAL", "Exponential", "Exponential slope distribution")],
-        default="GAUSSIAN", update=_type_changed,
-    )  # fmt: skip
-    facet: bpy.props.FloatProperty(
-        name="Surface Reflection", default=1.0, min=0.0, max=1.0, update=_colour_changed,
-        description="Weight of the reflection by the surface itself; changes render at once",
-    )  # fmt: skip
     lut_path: bpy.props.StringProperty(
         name="LUT", subtype="FILE_PATH", description="The baked lookup table", options=_RELATIVE_PATH,
     )  # fmt: skip
@@ -207,7 +182,8 @@ class PaintLUTSettings(bpy.types.PropertyGroup):
 
     def type_key(self) -> str:
         """The fields that shape the paint type, as text (a change means a bake)."""
-        return f"{_exact(self.n)}|{_exact(self.g)}|{_exact(self.slope)}|{self.distribution}|{self.spectral_paint}"
+        shape = (getattr(self, spec.name) for spec in MATERIAL_FIELDS if spec.shapes_type)
+        return "|".join([*(v if isinstance(v, str) else str(_exact(v)) for v in shape), self.spectral_paint])
 
     def to_paint(self, space: str | None = None) -> lut.Paint:
         """The lut.Paint these settings describe (a preset's exact spectral
@@ -223,17 +199,57 @@ class PaintLUTSettings(bpy.types.PropertyGroup):
             return dataclasses.replace(lut.Paint.from_dict(data), space=space)
         if self.preset != "CUSTOM":
             return lut.preset(self.preset, space)
-        return lut.Paint(
-            n=_exact(self.n),
-            rho=tuple(_exact(v) for v in self.rho),
-            single=tuple(_exact(v) for v in self.single),
-            g=_exact(self.g),
-            slope=_exact(self.slope),
-            distribution=self.distribution.lower(),
-            facet=_exact(self.facet),
-            space=space,
-        )
+        fields = {}
+        for spec in MATERIAL_FIELDS:
+            value = getattr(self, spec.name)
+            if spec.kind == "colour":
+                value = tuple(_exact(v) for v in value)
+            elif spec.kind == "choice":
+                value = value.lower()
+            else:
+                value = _exact(value)
+            fields[spec.name] = value
+        return lut.Paint(**fields, space=space)
 
+
+def paint_property(spec: schema.FieldSpec):
+    """The Blender property of a paint field: its label, default, tooltip,
+    the material's hard limits (``FieldSpec.material_range``) and the
+    slider's (``FieldSpec.soft``).  Fields that shape the paint type make
+    the bake stale; colours go to the node groups at once."""
+    common = {
+        "name": spec.label,
+        "description": spec.tooltip or spec.help[:1].upper() + spec.help[1:],
+        "update": _type_changed if spec.shapes_type else _colour_changed,
+    }
+    if spec.kind == "choice":
+        items = [(c.upper(), c.title(), f"{c.title()} {spec.help}") for c in spec.choices]
+        return bpy.props.EnumProperty(items=items, default=spec.default.upper(), **common)
+    limits = {}
+    hard = spec.material_range
+    for key, value in (("min", hard.low), ("max", hard.high), ("soft_min", spec.soft[0]), ("soft_max", spec.soft[1])):
+        if value is not None:
+            limits[key] = value
+    if spec.precision is not None:
+        limits["precision"] = spec.precision
+    if spec.kind == "colour":
+        return bpy.props.FloatVectorProperty(subtype="COLOR", size=3, default=spec.default, **limits, **common)
+    return bpy.props.FloatProperty(default=spec.default, **limits, **common)
+
+
+def _add_paint_fields(cls):
+    """Give ``cls`` a property per paint field a material stores, after its
+    ``preset`` (Blender reads the properties from the class annotations)."""
+    annotations = {}
+    for key, value in cls.__annotations__.items():
+        annotations[key] = value
+        if key == "preset":
+            annotations.update((spec.name, paint_property(spec)) for spec in MATERIAL_FIELDS)
+    cls.__annotations__ = annotations
+    return cls
+
+
+_add_paint_fields(PaintLUTSettings)
 
 CLASSES = (PaintLUTSettings,)
 

@@ -24,6 +24,7 @@ from . import __version__, baking, cleanup, colour_management, lutfile, presets,
 from .baking import BAKE_SINGLE_NODES
 from .models.rough import DIFFUSE_NODES
 from .paint import Paint
+from .schema import PAINT_FIELDS, check_range
 
 DEFAULT_OUT = "out"
 #: The largest LUT the command line bakes: N_u * N_theta_d * N_phi_d nodes
@@ -31,13 +32,11 @@ DEFAULT_OUT = "out"
 MAX_NODES = 256 * 128 * 128
 #: The largest quadrature size per axis (the defaults are 3 to 6).
 MAX_QUADRATURE = 64
-#: The paint parameters the command line accepts, as the Blender panel's:
-#: outside them the models overflow or the LUT cannot resolve the lobe.
-INDEX_RANGE = (1.0, 4.0)
-SLOPE_RANGE = (0.0, 3.0)
-#: The smallest non-zero slope: a narrower facet lobe than this is not
-#: resolved by any LUT resolution the command line bakes (use 0 for smooth).
-MIN_ROUGH_SLOPE = 1e-3
+#: The paint fields the command line takes as options (and reads from paint
+#: files: every field), with its limits where narrower than lut.Paint's
+#: (``FieldSpec.bake``: outside them the models overflow or the LUT cannot
+#: resolve the facet lobe).
+OPTIONS = tuple(spec for spec in PAINT_FIELDS.values() if spec.command_line)
 
 
 def _progress_bar(label):
@@ -73,19 +72,16 @@ def _bake_one(paint, out, args, label):
     return path, time.perf_counter() - start
 
 
-_OVERRIDES = ("n", "rho", "single", "g", "slope", "distribution", "facet", "space")
-
-
 def _overrides(args) -> dict:
     """The paint fields given as options."""
     fields = {}
-    for key in _OVERRIDES:
-        value = getattr(args, key)
+    for spec in OPTIONS:
+        value = getattr(args, spec.name)
         if value is None:
             continue
-        if key in ("rho", "single"):
+        if spec.kind == "colour":
             value = value[0] if len(value) == 1 else tuple(value)
-        fields[key] = value
+        fields[spec.name] = value
     return fields
 
 
@@ -129,16 +125,17 @@ def _paint_from_args(args) -> Paint:
 
 
 def _check_limits(paint: Paint) -> None:
-    """The command line's limits (INDEX_RANGE, SLOPE_RANGE): beyond them the
-    models overflow or the LUT cannot resolve the facet lobe."""
-    low, high = INDEX_RANGE
-    indices = [paint.index_at(wl) for wl in (380.0, 780.0)] if paint.dispersive else [paint.n]
-    for n in indices:
-        if not low <= n <= high:
-            raise ValueError(f"n must be in [{low:g}, {high:g}], got {n:g}")
-    low, high = SLOPE_RANGE
-    if not (paint.slope == 0.0 or MIN_ROUGH_SLOPE <= paint.slope <= high):
-        raise ValueError(f"slope must be 0 (smooth) or in [{MIN_ROUGH_SLOPE:g}, {high:g}], got {paint.slope:g}")
+    """The command line's limits (``FieldSpec.bake``): beyond them the
+    models overflow or the LUT cannot resolve the facet lobe.  A dispersive
+    index is checked at both ends of the visible range."""
+    for spec in OPTIONS:
+        if spec.bake is None:
+            continue
+        values = [getattr(paint, spec.name)]
+        if spec.kind == "index" and paint.dispersive:
+            values = [float(paint.index_at(wl)) for wl in (380.0, 780.0)]
+        for value in values:
+            check_range(value, spec.name, spec.bake, noun="")
 
 
 def _check_sizes(args) -> None:
@@ -239,7 +236,8 @@ def _cmd_example(args) -> int:
     return 0
 
 
-def main(argv=None) -> int:
+def build_parser() -> argparse.ArgumentParser:
+    """The command line's parser (its ``bake`` options: ``OPTIONS``)."""
     parser = argparse.ArgumentParser(
         prog="python -m lut",
         description="Paint LUT: physically based paint appearance from T. A. Germer's polarized light-scattering "
@@ -275,20 +273,14 @@ def main(argv=None) -> int:
     source = b.add_mutually_exclusive_group()
     source.add_argument("--preset", choices=list(presets.PRESETS), help="one of the paper's three samples")
     source.add_argument("--paint", metavar="FILE", help="a .json or .toml file of paint fields (see docs/lut.md)")
-    b.add_argument("--n", type=float, help="binder refractive index (default 1.5)")
-    b.add_argument(
-        "--rho", nargs="+", metavar="V", help="diffuse reflectance: grey value, R G B, or a spectrum name/.csv"
-    )
-    b.add_argument(
-        "--single", nargs="+", metavar="V", help="single-scatter weight: grey, R G B, or spectrum (default 0)"
-    )
-    b.add_argument("--g", type=float, help="Henyey-Greenstein asymmetry, -1 < g < 1 (default 0)")
-    b.add_argument("--slope", type=float, help="RMS slope of the interface, 0 = smooth (default 0)")
-    b.add_argument("--distribution", choices=["gaussian", "exponential"], help="slope distribution (default gaussian)")
-    b.add_argument("--facet", type=float, help="weight of the interface reflection (default 1)")
-    b.add_argument(
-        "--space", choices=list(colour_management.WORKING_SPACES), help="working space (default Linear Rec.709)"
-    )
+    for spec in OPTIONS:  # the paint's fields (lut.schema)
+        if spec.kind == "colour":
+            kind = {"nargs": "+", "metavar": "V"}
+        elif spec.choices:
+            kind = {"choices": list(spec.choices)}
+        else:
+            kind = {"type": float}
+        b.add_argument(f"--{spec.name}", help=spec.command_line_help(), **kind)
     bake_options(b)
 
     info = sub.add_parser("info", help="print LUT files' metadata (and verify their content hashes)")
@@ -306,9 +298,14 @@ def main(argv=None) -> int:
     )
     clean.add_argument("--dry-run", action="store_true", help="only list what would be removed")
 
+    return parser
+
+
+def main(argv=None) -> int:
+    parser = build_parser()
     args = parser.parse_args(argv)
     if args.command == "bake":
-        for key in ("rho", "single"):
+        for key in (spec.name for spec in OPTIONS if spec.kind == "colour"):
             value = getattr(args, key)
             if value is not None and len(value) in (1, 3):
                 try:

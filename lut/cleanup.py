@@ -11,7 +11,7 @@ from __future__ import annotations
 import pathlib
 import re
 
-from . import lutfile
+from . import files
 
 _LUT = re.compile(r"^paintlut-(?P<key>[0-9a-f]{8,64})\.exr$")
 _WEIGHTS = re.compile(r"^paintfit-(?:[a-z0-9]+-)?(?P<key>[0-9a-f]{8,64})\.exr$")
@@ -49,7 +49,7 @@ def clean(directory, keep, dry_run=False) -> list[pathlib.Path]:
     returns what was (with ``dry_run``: would be) removed."""
     unused = unused_files(directory, keep)
     if dry_run:
-        return unused + [p for p in sorted(pathlib.Path(directory).glob(".*.partial*")) if lutfile.is_stale_partial(p)]
+        return unused + [p for p in sorted(pathlib.Path(directory).glob(".*.partial*")) if files.is_stale_partial(p)]
     removed = []
     for path in unused:
         try:
@@ -57,4 +57,4 @@ def clean(directory, keep, dry_run=False) -> list[pathlib.Path]:
         except FileNotFoundError:
             continue
         removed.append(path)
-    return removed + lutfile.remove_stale_partials(directory)
+    return removed + files.remove_stale_partials(directory)

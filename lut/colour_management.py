@@ -17,10 +17,11 @@ from __future__ import annotations
 
 import csv
 import functools
-import math
 import pathlib
 
 import numpy as np
+
+from .models import _validate
 
 #: Blender working-space names and their colour-science colourspaces.
 WORKING_SPACES = {
@@ -106,6 +107,10 @@ def spectrum_to_rgb(values, space: str = DEFAULT_SPACE) -> np.ndarray:
     return np.asarray(values) @ spectral_weights(space).T
 
 
+#: A spectrum's scale factor.
+_SCALE = _validate.Range(0.0, None)
+
+
 class Spectrum:
     """A spectral reflectance (or weight), sampled at WAVELENGTHS.
 
@@ -117,9 +122,8 @@ class Spectrum:
 
     def __init__(self, source, values=None, *, name=None, scale=1.0):
         if isinstance(scale, bool) or not isinstance(scale, (int, float, np.floating, np.integer)):
-            raise ValueError(f"spectrum scale must be a finite number >= 0, got {scale!r}")
-        if not (math.isfinite(scale) and scale >= 0):
-            raise ValueError(f"spectrum scale must be a finite number >= 0, got {scale!r}")
+            raise _validate.range_error(scale, "spectrum scale", _SCALE)  # not a number (float() would take text)
+        _validate.check_range(scale, "spectrum scale", _SCALE)
         if values is not None:
             try:
                 wl, val = np.asarray(source, dtype=float), np.asarray(values, dtype=float)

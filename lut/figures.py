@@ -12,13 +12,12 @@ single wavelengths are used: 632.8 nm for the white and CARC paints,
 
 from __future__ import annotations
 
-import os
 import pathlib
-import tempfile
 
 import numpy as np
 
 from . import models, presets
+from .files import atomic_target
 
 THETA_I = np.radians(60.0)
 SIGMAS = (0.05, 0.1, 0.2, 0.3, 0.5, 1.0)
@@ -36,18 +35,9 @@ def _pyplot():
 
 
 def _save(fig, path):
-    """Write a figure atomically (temporary file, then rename)."""
-    path = pathlib.Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.stem}.", suffix=".png")
-    os.close(fd)
-    try:
-        fig.savefig(tmp, dpi=110)
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+    """Write a figure atomically (``lut.files.atomic_target``)."""
+    with atomic_target(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
     return path
 
 

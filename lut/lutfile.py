@@ -26,21 +26,16 @@ malformed file, whatever the damage, raises LUTError naming it.
 
 from __future__ import annotations
 
-import contextlib
-import errno
 import hashlib
 import json
-import os
 import pathlib
-import re
-import socket
-import stat
-import tempfile
-import time
 
 import numpy as np
 
 from . import exr
+
+# Re-exported: addon/batch.py and scripts/batch_bake.py write through lutfile.
+from .files import atomic_target, atomic_write_bytes  # noqa: F401
 
 FORMAT_VERSION = 2
 PARAMETERIZATION = "rusinkiewicz(theta_h=pi/2*u^2, theta_d, phi_d in [0, pi/2]); G = f cos(theta_i) cos(theta_s)"
@@ -156,112 +151,6 @@ def _to_image(table: np.ndarray) -> np.ndarray:
     """(tiles, N_φd, N_θd, N_u, 3) or (N_φd, N_θd, N_u, 3) -> (height, N_u, 3)."""
     n_u, c = table.shape[-2:]
     return np.ascontiguousarray(table.reshape(-1, n_u, c), dtype=np.float32)
-
-
-#: A partial file from a writer that cannot be asked whether it still runs
-#: (another host, or no process ids) is stale after this many seconds.
-STALE_PARTIAL_SECONDS = 24 * 3600
-
-_PARTIAL = re.compile(r"^\..*?\.(?:(?P<pid>\d+)@(?P<host>[A-Za-z0-9_-]*)\.)?[A-Za-z0-9_]+\.partial(?:\.[^.]*)?$")
-
-
-def _host() -> str:
-    return re.sub(r"[^A-Za-z0-9_-]", "_", socket.gethostname())[:64]
-
-
-def _process_alive(pid: int) -> bool:
-    if os.name != "posix":  # os.kill would terminate the process on Windows
-        return True
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except (PermissionError, OverflowError):
-        return True
-    return True
-
-
-def is_stale_partial(path, now=None) -> bool:
-    """Whether ``path`` is the temporary file of an atomic write whose writer
-    is gone: a process of this host that no longer runs (killed, crashed),
-    or, for another host's, older than STALE_PARTIAL_SECONDS."""
-    path = pathlib.Path(path)
-    match = _PARTIAL.match(path.name)
-    if match is None:
-        return False
-    try:
-        age = (time.time() if now is None else now) - path.stat().st_mtime
-    except OSError:
-        return False
-    if match["pid"] and match["host"] == _host():
-        return not _process_alive(int(match["pid"]))
-    return age > STALE_PARTIAL_SECONDS
-
-
-def remove_stale_partials(directory) -> list[pathlib.Path]:
-    """Remove the temporary files that interrupted atomic writes left in
-    ``directory`` (``is_stale_partial``); returns them."""
-    removed = []
-    try:
-        candidates = sorted(pathlib.Path(directory).glob(".*.partial*"))
-    except OSError:
-        return removed
-    for candidate in candidates:
-        if candidate.is_file() and is_stale_partial(candidate):
-            with contextlib.suppress(FileNotFoundError):
-                candidate.unlink()
-                removed.append(candidate)
-    return removed
-
-
-def _new_file_mode() -> int:
-    """The mode a plain open() would give a new file (0o666 less the umask)."""
-    try:
-        with open("/proc/self/status") as fh:
-            umask = next(int(line.split()[1], 8) for line in fh if line.startswith("Umask:"))
-    except (OSError, StopIteration, ValueError, IndexError):
-        umask = os.umask(0o022)
-        os.umask(umask)
-    return 0o666 & ~umask
-
-
-@contextlib.contextmanager
-def atomic_target(path):
-    """Write a file atomically: yields a temporary path in the same directory
-    (same suffix, so writers that go by the extension work) that is renamed
-    onto ``path`` when the block succeeds and removed when it fails, so an
-    interrupted write never leaves a partial file and never loses the old one.
-    The file keeps the permissions of the one it replaces (a new one gets
-    the umask's).  The temporary file's name holds this process's id and
-    host, so a later write in the directory can remove it if the process was
-    killed (``remove_stale_partials``)."""
-    path = pathlib.Path(path)
-    if path.is_dir():
-        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    remove_stale_partials(path.parent)
-    try:
-        mode = stat.S_IMODE(path.stat().st_mode)
-    except FileNotFoundError:
-        mode = _new_file_mode()
-    fd, tmp = tempfile.mkstemp(
-        dir=path.parent, prefix=f".{path.stem}.{os.getpid()}@{_host()}.", suffix=f".partial{path.suffix}"
-    )
-    os.close(fd)
-    try:
-        yield tmp
-        os.chmod(tmp, mode)
-        os.replace(tmp, path)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            os.remove(tmp)
-
-
-def atomic_write_bytes(path, data: bytes) -> pathlib.Path:
-    """Write bytes to ``path`` atomically (``atomic_target``)."""
-    with atomic_target(path) as tmp, open(tmp, "wb") as fh:
-        fh.write(data)
-    return pathlib.Path(path)
 
 
 def write_exr(path, image: np.ndarray, attributes: dict) -> pathlib.Path:

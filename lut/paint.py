@@ -32,6 +32,7 @@ from . import colour_management as cm
 from . import models
 from .models import _validate, fresnel
 from .models.rough import DIFFUSE_NODES, SINGLE_NODES
+from .schema import PAINT_FIELDS
 
 #: Band edges [nm] for a dispersive index: the geometry is evaluated at each
 #: band's centre wavelength.
@@ -71,24 +72,27 @@ def _internal_reflectance(n, slope, distribution, diffuse_nodes):
 
 
 def _colour_value(value, name: str):
-    """An RGB triple (or a grey scalar) in [0, 1], or a Spectrum (given as
-    one, as a dataset name or .csv path, or as a dict; see Paint.from_dict)."""
+    """An RGB triple (or a grey scalar) in the field's range ([0, 1]), or a
+    Spectrum (given as one, as a dataset name or .csv path, or as a dict; see
+    Paint.from_dict)."""
+    spec = PAINT_FIELDS[name]
+    within = spec.allowed.text(name)
     if isinstance(value, (str, dict)):
         value = _colour_from_json(value, name)
     if isinstance(value, cm.Spectrum):
-        if np.any(value.values < 0) or np.any(value.values > 1):
-            raise ValueError(f"{name} spectrum must lie in [0, 1] at every wavelength")
+        if not all(spec.allowed.contains(float(v)) for v in value.values):
+            raise ValueError(f"{name} spectrum must lie {within} at every wavelength")
         return value
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         value = (value, value, value)
     try:
         triple = tuple(float(v) for v in value)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be an RGB triple of numbers in [0, 1], a grey number or a Spectrum") from None
+        raise ValueError(f"{name} must be an RGB triple of numbers {within}, a grey number or a Spectrum") from None
     if len(triple) != 3:
-        raise ValueError(f"{name} must be an RGB triple of numbers in [0, 1], got {len(triple)} values")
+        raise ValueError(f"{name} must be an RGB triple of numbers {within}, got {len(triple)} values")
     for v in triple:
-        _validate.reflectance(v, name)
+        spec.check(v)
     return triple
 
 
@@ -96,7 +100,7 @@ def _index(value):
     """n: a number > 0, or Cauchy coefficients (A, B[, C...]) giving
     n(λ) = A + B/λ² + C/λ⁴ + ... with λ in µm."""
     if isinstance(value, (int, float)) and not isinstance(value, bool):
-        return _validate.index(value)
+        return PAINT_FIELDS["n"].check(value)
     try:
         coeffs = tuple(float(c) for c in value)
     except (TypeError, ValueError):
@@ -104,7 +108,7 @@ def _index(value):
     if not 1 <= len(coeffs) <= 4 or not all(math.isfinite(c) for c in coeffs):
         raise ValueError("n as Cauchy coefficients must be 1 to 4 finite numbers (A, B, C, D), lambda in um")
     for wl in (0.38, 0.78):
-        _validate.index(_cauchy(coeffs, wl))
+        PAINT_FIELDS["n"].check(_cauchy(coeffs, wl))
     return coeffs if len(coeffs) > 1 else coeffs[0]
 
 
@@ -121,48 +125,48 @@ def reference_index(n) -> float:
     return float(_cauchy(tuple(n), REFERENCE_WAVELENGTH / 1000.0))
 
 
+def _field_lines() -> str:
+    """The docstring's list of fields, from the schema."""
+    lines = []
+    for spec in PAINT_FIELDS.values():
+        allowed = spec.allowed_text().replace("`", "")
+        allowed = f"; {allowed}" if allowed else ""
+        lines.append(f"    {spec.name:13} {spec.help}{allowed}; default {spec.default_text()}")
+    return "\n".join(lines).lstrip()
+
+
+#: How each kind of field (``lut.schema.KINDS``) is checked and normalized.
+_CHECKS = {
+    "index": lambda spec, value: _index(value),
+    "colour": lambda spec, value: _colour_value(value, spec.name),
+    "number": lambda spec, value: spec.check(value),
+    "choice": lambda spec, value: _CHOICES[spec.name](value),
+    "text": lambda spec, value: value,  # a label, checked by from_dict
+}
+_CHOICES = {"distribution": _validate.distribution, "space": cm.working_space}
+
+
 @dataclasses.dataclass(frozen=True)
 class Paint:
     """A paint (paper Sec. 4).  All fields are keywords; see the module
-    docstring for how they combine.
+    docstring for how they combine.  The fields (``lut.schema.PAINT_FIELDS``):
 
-    n             binder index (> 0), or Cauchy coefficients for a spectral paint
-    rho           diffuse subsurface reflectance: RGB triple, grey number or Spectrum, in [0, 1]
-    single        weight of the single-scatter term: RGB, grey or Spectrum (default 0)
-    g             Henyey-Greenstein asymmetry, -1 < g < 1 (default 0)
-    slope         total RMS slope of the interface, >= 0 (0: smooth; default 0)
-    distribution  'gaussian' or 'exponential' slope distribution
-    facet         weight of the facet (interface) reflection, >= 0 (default 1)
-    space         working space of RGB values and of the results
-    name          a label (not part of the physics)
+    {fields}
     """
 
-    n: Any = 1.5
-    rho: Any = (0.8, 0.8, 0.8)
-    single: Any = 0.0
-    g: float = 0.0
-    slope: float = 0.0
-    distribution: str = "gaussian"
-    facet: float = 1.0
-    space: str = cm.DEFAULT_SPACE
-    name: str = ""
+    n: Any = PAINT_FIELDS["n"].default
+    rho: Any = PAINT_FIELDS["rho"].default
+    single: Any = PAINT_FIELDS["single"].default
+    g: float = PAINT_FIELDS["g"].default
+    slope: float = PAINT_FIELDS["slope"].default
+    distribution: str = PAINT_FIELDS["distribution"].default
+    facet: float = PAINT_FIELDS["facet"].default
+    space: str = PAINT_FIELDS["space"].default
+    name: str = PAINT_FIELDS["name"].default
 
     def __post_init__(self):
-        setattr_ = object.__setattr__
-        setattr_(self, "n", _index(self.n))
-        setattr_(self, "rho", _colour_value(self.rho, "rho"))
-        setattr_(self, "single", _colour_value(self.single, "single"))
-        setattr_(self, "g", _validate.asymmetry(self.g))
-        setattr_(self, "slope", _validate.rms_slope(self.slope))
-        setattr_(self, "distribution", _validate.distribution(self.distribution))
-        try:
-            facet = float(self.facet)
-        except (TypeError, ValueError):
-            raise ValueError(f"facet must be a finite number >= 0, got {self.facet!r}") from None
-        if not math.isfinite(facet) or facet < 0:
-            raise ValueError(f"facet must be a finite number >= 0, got {self.facet!r}")
-        setattr_(self, "facet", facet)
-        setattr_(self, "space", cm.working_space(self.space))
+        for spec in PAINT_FIELDS.values():
+            object.__setattr__(self, spec.name, _CHECKS[spec.kind](spec, getattr(self, spec.name)))
         if self.dispersive and not self.spectral:
             raise ValueError("n as Cauchy coefficients needs a spectral paint (rho or single given as a Spectrum)")
         if self.spectral:
@@ -287,7 +291,7 @@ class Paint:
         {"wavelengths": [...], "values": [...]} (optionally with "scale")."""
         if not isinstance(data, dict):
             raise ValueError("a paint description must be a table/object of fields")
-        fields = {f.name for f in dataclasses.fields(cls)}
+        fields = set(PAINT_FIELDS)
         unknown = set(map(str, data)) - fields
         if unknown:
             raise ValueError(
@@ -409,6 +413,10 @@ class Paint:
             white = cm.spectral_weights(self.space)[:, band].sum(axis=1) if self.spectral else np.ones(3)
             out += refl[..., None] * self.facet * white
         return out
+
+
+if Paint.__doc__:  # not under python -OO
+    Paint.__doc__ = Paint.__doc__.format(fields=_field_lines())
 
 
 def _colour_from_json(value, name):

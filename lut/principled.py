@@ -47,6 +47,7 @@ import numpy as np
 
 from .closures import Closure, _ggx
 from .fitting import ACCEPTANCE_GRID
+from .models import _validate
 
 #: Bounds of the fitted parameters (the Principled node's own ranges where it
 #: has them; IOR within what paints' binders and coats span, widened).
@@ -54,6 +55,9 @@ BOUNDS = {"roughness": (0.0, 1.0), "ior": (1.01, 2.5), "coat_weight": (0.0, 1.0)
 
 #: Resolution of Cycles' ggx_gen_schlick_ior_s table per axis.
 TABLE_SIZE = 16
+#: The ranges of the roughnesses and weights, and of the IORs, that a fit gives.
+_UNIT = _validate.Range(0.0, 1.0)
+_IOR = _validate.Range(1.0, 4.0, low_open=True)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -75,15 +79,9 @@ class PrincipledParams:
             raise ValueError(f"base_color must be an RGB triple in [0, 1], got {self.base_color!r}")
         object.__setattr__(self, "base_color", colour)
         for name in ("roughness", "coat_weight", "coat_roughness"):
-            value = float(getattr(self, name))
-            if not 0.0 <= value <= 1.0:
-                raise ValueError(f"{name} must be in [0, 1], got {value!r}")
-            object.__setattr__(self, name, value)
+            object.__setattr__(self, name, _validate.check_range(getattr(self, name), name, _UNIT))
         for name in ("ior", "coat_ior"):
-            value = float(getattr(self, name))
-            if not 1.0 < value <= 4.0:
-                raise ValueError(f"{name} must be in (1, 4], got {value!r}")
-            object.__setattr__(self, name, value)
+            object.__setattr__(self, name, _validate.check_range(getattr(self, name), name, _IOR))
 
     def node_inputs(self) -> dict:
         """{Principled BSDF input name: value} (Blender 4.0+ names)."""

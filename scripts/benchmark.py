@@ -19,7 +19,7 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
-from lut import bench, presets, table  # noqa: E402
+from lut import bench, files, presets, table  # noqa: E402
 from lut.baking import BAKE_SINGLE_NODES  # noqa: E402
 
 DEFAULT_PLOT = "out/bake_benchmark.png"
@@ -59,8 +59,8 @@ def main(argv=None):
     ax.legend()
     fig.tight_layout()
     out = pathlib.Path(args.plot)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=110)
+    with files.atomic_target(out) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
     print(f"\nplot: {out}")
 
 

@@ -34,7 +34,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from lut import eevee  # noqa: E402
+from lut import eevee, files  # noqa: E402
 from lut.closures import Closure  # noqa: E402
 
 #: The generated module of tables.
@@ -272,7 +272,7 @@ def write_module(path, version, tables):
         "}",
         "",
     ]
-    path.write_text("\n".join(lines))
+    files.atomic_write_text(path, "\n".join(lines))
 
 
 def measure(todo, per_render=25):

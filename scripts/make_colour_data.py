@@ -15,7 +15,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from lut import colour_management as cm  # noqa: E402
-from lut import lutfile  # noqa: E402
+from lut import files  # noqa: E402
 
 #: colour-science collections stored whole (the presets use two of its patches).
 COLLECTIONS = ("ColorChecker N Ohta",)
@@ -57,7 +57,7 @@ def build() -> str:
 
 def main() -> int:
     target = ROOT / "lut" / "colour_data.py"
-    lutfile.atomic_write_bytes(target, build().encode())
+    files.atomic_write_text(target, build())
     print(f"wrote {target.relative_to(ROOT)}")
     return 0
 

@@ -15,10 +15,10 @@ Mueller BRDF returned by ``BRDF_Model.MuellerBRDF(thetai, thetas, phis, 0,
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import os
 import sys
-import tempfile
 
 import numpy as np
 from pySCATMECH.brdf import BRDF_Model
@@ -158,6 +158,15 @@ def build(count, seed):
     return cases
 
 
+def _files(here):
+    """lut/files.py on its own: it needs only the standard library, while
+    this script runs in SCATMECH's venv, which lacks lut's dependencies."""
+    spec = importlib.util.spec_from_file_location("paint_lut_files", os.path.join(here, "..", "lut", "files.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 def main(argv=None):
     here = os.path.dirname(os.path.abspath(__file__))
     default = os.path.join(here, "..", "tests", "fixtures", "scatmech_reference.json")
@@ -172,11 +181,7 @@ def main(argv=None):
         "cases": build(args.count, args.seed),
     }
     out = os.path.abspath(args.out)
-    fd, tmp = tempfile.mkstemp(dir=os.path.dirname(out), suffix=".tmp")
-    with os.fdopen(fd, "w") as fh:
-        json.dump(data, fh, separators=(",", ":"))
-    os.chmod(tmp, 0o644)
-    os.replace(tmp, out)
+    _files(here).atomic_write_text(out, json.dumps(data, separators=(",", ":")))
     print(f"wrote {len(data['cases'])} cases to {out}", file=sys.stderr)
 
 

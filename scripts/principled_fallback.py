@@ -43,10 +43,9 @@ def main(argv=None) -> int:
         rows[name] = {"fit": error, "rendered": rendered, "artist": artist, "params": params.to_dict()}
         print(f"{name:16} {error:7.4f} {rendered:7.4f} {artist:7.4f}  {params}")
     if args.out:
-        from lut.lutfile import atomic_target
+        from lut.files import atomic_write_text
 
-        with atomic_target(args.out) as tmp:
-            pathlib.Path(tmp).write_text(json.dumps(rows, indent=1))
+        atomic_write_text(args.out, json.dumps(rows, indent=1))
     return 0
 
 

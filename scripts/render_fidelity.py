@@ -29,7 +29,7 @@ import numpy as np  # noqa: E402
 from blender_oracle import EEVEE, GRID, GRID_EEVEE, Oracle, paint_material, paints, principled, relative_rms  # noqa: E402
 
 import addon  # noqa: E402
-from lut import bench, lutfile  # noqa: E402
+from lut import bench, files  # noqa: E402
 
 
 def measure(paint, directory, eevee=True, lobes_4x=True, baseline=True, cycles=True):
@@ -84,7 +84,7 @@ def main(argv=None) -> int:
             )
             rows[label]["random"] = True
             print(label, {k: (round(v, 4) if isinstance(v, float) else v) for k, v in rows[label].items()}, flush=True)
-    lutfile.atomic_write_bytes(args.out, (json.dumps(rows, indent=2) + "\n").encode())
+    files.atomic_write_text(args.out, json.dumps(rows, indent=2) + "\n")
     if args.only_eevee or args.no_eevee:
         print("(a partial run: merge it with the other into the README's table by hand)")
     print("| paint | Cycles (fit reports) | Cycles, 4.2-4.5 lobes | EEVEE | Principled BSDF: best scale (as is) |")

@@ -23,7 +23,7 @@ import bpy  # noqa: E402
 import addon  # noqa: E402
 import lut  # noqa: E402
 from addon import api  # noqa: E402
-from lut import lutfile  # noqa: E402
+from lut import files  # noqa: E402
 
 
 def build_scene(width, height, samples):
@@ -74,7 +74,7 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         for sphere, name in zip(spheres, lut.PRESETS, strict=True):
             sphere.data.materials.append(api.new_material(name, lut.preset(name), directory=pathlib.Path(tmp)))
-        with lutfile.atomic_target(args.out) as partial:
+        with files.atomic_target(args.out) as partial:
             scene.render.filepath = partial
             bpy.ops.render.render(write_still=True)
     print(args.out)

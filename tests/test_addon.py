@@ -51,13 +51,41 @@ def test_defaults_are_the_paint_defaults(material):
     assert api.paint_of(material) == lut.Paint()
 
 
-def test_limits_follow_the_paint_limits(addon_registered):
+#: The material settings that are not paint fields.
+NOT_PAINT_FIELDS = {"rna_type", "name", "enabled", "preset", "lut_path", "stale", "internal_reflectance",
+                    "diffuse_albedo", "seen", "fits", "spectral_paint"}  # fmt: skip
+
+
+def _float32(value):
+    return float(np.float32(value))
+
+
+def test_material_properties_are_the_schemas_fields_with_its_limits(addon_registered):
+    """Every paint field the schema puts on a material is a property (and no
+    other paint field is), with the schema's label, default, tooltip, hard
+    and soft limits; the hard limits lie within what lut.Paint accepts."""
+    from lut.schema import PAINT_FIELDS
+
     props = addon_registered.properties.PaintLUTSettings.bl_rna.properties
-    assert props["n"].hard_min == 1.0
-    assert props["g"].hard_min > -1.0 and props["g"].hard_max < 1.0
-    assert props["slope"].hard_min == 0.0 and props["slope"].hard_max == 3.0
-    assert tuple(props["rho"].default_array) == pytest.approx((0.8, 0.8, 0.8)) and props["rho"].hard_max == 1.0
-    assert props["facet"].hard_min == 0.0
+    on_material = {name for name, spec in PAINT_FIELDS.items() if spec.on_material}
+    assert on_material == {"n", "rho", "single", "g", "slope", "distribution", "facet"}
+    assert {p.identifier for p in props} - NOT_PAINT_FIELDS == on_material
+    for name in on_material:
+        spec, prop = PAINT_FIELDS[name], props[name]
+        assert prop.name == spec.label and prop.description, name
+        if spec.kind == "choice":
+            assert [item.identifier.lower() for item in prop.enum_items] == list(spec.choices)
+            assert prop.default == spec.default.upper()
+            continue
+        hard = spec.material_range
+        assert not hard.low_open and not hard.high_open and hard.bounded, name  # Blender's limits are closed
+        assert (prop.hard_min, prop.hard_max) == (_float32(hard.low), _float32(hard.high)), name
+        assert hard.low in spec.allowed and hard.high in spec.allowed, name
+        soft_min, soft_max = spec.soft
+        assert prop.soft_min == _float32(hard.low if soft_min is None else soft_min), name
+        assert prop.soft_max == _float32(hard.high if soft_max is None else soft_max), name
+        default = tuple(prop.default_array) if spec.kind == "colour" else prop.default
+        assert default == pytest.approx(spec.default), name
 
 
 def test_preset_fills_the_fields_with_the_rgb_that_renders_it_exactly(material):
@@ -459,3 +487,52 @@ def test_the_export_fallback_follows_colour_edits(material, lut_dir):
     assert after.roughness == before.roughness and after.ior == before.ior
     assert after.base_color[2] > after.base_color[0] and before.base_color[0] > before.base_color[2]
     assert error is not None and error < 0.1
+
+
+def test_a_paint_beyond_a_materials_limits_is_refused_naming_them(addon_registered):
+    """check_paint_fits takes the panel fields' limits from the schema (equal
+    to the properties', test above): just beyond one, the paint is refused."""
+    from addon import validation
+    from lut.schema import PAINT_FIELDS
+
+    for name, spec in PAINT_FIELDS.items():
+        if not spec.on_material or spec.material is None:
+            continue
+        limits = spec.material
+        value = limits.high + 0.005
+        paint = lut.Paint(**{name: value})
+        with pytest.raises(ValueError, match=f"^{name} must be {limits.text(name)}".replace("[", r"\[")):
+            validation.check_paint_fits(paint, paint.space)
+        validation.check_paint_fits(lut.Paint(**{name: limits.high}), paint.space)
+
+
+class _Layout:
+    """Records the properties a panel draws."""
+
+    def __init__(self):
+        self.props = []
+
+    def prop(self, data, name):
+        assert name in data.bl_rna.properties, name
+        self.props.append(name)
+
+    def column(self, **_):
+        return self
+
+    row = column
+
+    def label(self, **_):
+        pass
+
+    def operator(self, *_, **__):
+        pass
+
+
+def test_the_panel_shows_every_material_field_colours_first(material):
+    from addon import panels, properties
+
+    layout = _Layout()
+    panels.draw_settings(layout, material)
+    fields = [spec.name for spec in properties.MATERIAL_FIELDS]
+    assert [p for p in layout.props if p in fields] == ["rho", "single", "facet", "n", "g", "slope", "distribution"]
+    assert layout.props[:3] == ["enabled", "preset", "seen"]

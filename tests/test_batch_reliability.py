@@ -226,7 +226,7 @@ def test_a_material_whose_bake_raises_anything_fails_alone(tmp_path, monkeypatch
     assert entry["materials"]["good"]["status"] == "baked"
     assert entry["materials"]["broken"] == {"status": "failed", "reason": "ZeroDivisionError: float division by zero"}
     assert entry["materials"]["spectral"]["status"] == "failed"
-    assert "spectrum scale must be a finite number >= 0, got None" in entry["materials"]["spectral"]["reason"]
+    assert "spectrum scale must be a finite real number >= 0, got None" in entry["materials"]["spectral"]["reason"]
     bpy.ops.wm.open_mainfile(filepath=str(blend))
     assert addon.nodes.group_of(bpy.data.materials["good"]) is not None  # its bake was saved
 

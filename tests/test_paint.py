@@ -127,7 +127,7 @@ def test_paint_round_trips_through_json(tmp_path):
         ({"g": 1.0}, "g must be"),
         ({"slope": -1}, "slope must be"),
         ({"distribution": "cauchy"}, "distribution must be one of"),
-        ({"facet": -1}, "facet must be a finite number >= 0"),
+        ({"facet": -1}, "facet must be a finite real number >= 0"),
         ({"space": "sRGB"}, "space must be one of 'Linear Rec.709'"),
         ({"rho": lut.Spectrum.flat(0.5), "single": (0.1, 0.2, 0.3)}, "single must be a Spectrum or a grey value"),
     ],
