@@ -257,13 +257,27 @@ BIN_THETA = np.radians(np.arange(0.0, 75.1, 5.0))
 BIN_PHI = np.radians(np.arange(20.0, 180.1, 15.0))
 
 
+#: Samples nearer the mirror direction than this are left out of
+#: ``binned_error``, as the acceptance grid's nearest point (θl = 0, θv =
+#: 5°) is this far from it.
+MIRROR_DISTANCE = np.radians(5.0)
+
+
+def mirror_distance(theta_l, theta_v, phi):
+    """Angle between the view and the mirror direction of the light (light
+    at azimuth π, φ = 0 the mirror's azimuth)."""
+    cos = np.cos(theta_l) * np.cos(theta_v) + np.sin(theta_l) * np.sin(theta_v) * np.cos(phi)
+    return np.arccos(np.clip(cos, -1.0, 1.0))
+
+
 def binned_error(theta_l, theta_v, phi, rendered, model, min_pixels=3):
     """The acceptance measure on pixel samples of any geometry (e.g. the
     pixels of spheres under a sun, each its own (θl, θv, φ)): the samples are
     binned on (θl, θv, |φ|) (``BIN_THETA``, ``BIN_PHI``; bin centres at the
     nodes), each bin's mean rendered and model radiance compared, and the
     bins weighted by cos θl as the acceptance measure weights its grid
-    points: sqrt(Σ cos²θl·|mean rendered − mean model|² / Σ cos²θl·|mean
+    points (samples within ``MIRROR_DISTANCE`` of the mirror direction left
+    out, as the grid stays that far from it): sqrt(Σ cos²θl·|mean rendered − mean model|² / Σ cos²θl·|mean
     model|²) over bins with at least ``min_pixels`` samples, all channels.
     ``rendered`` and ``model`` are radiances (N, 3) per unit irradiance
     (f·cos θl).  Returns (error, bins used)."""
@@ -276,6 +290,7 @@ def binned_error(theta_l, theta_v, phi, rendered, model, min_pixels=3):
         (theta_l <= BIN_THETA[-1] + step_t / 2)
         & (theta_v <= BIN_THETA[-1] + step_t / 2)
         & (ph >= BIN_PHI[0] - step_p / 2)
+        & (mirror_distance(theta_l, theta_v, phi) >= MIRROR_DISTANCE)
     )
     il = np.clip(np.rint(theta_l / step_t), 0, BIN_THETA.size - 1).astype(int)
     iv = np.clip(np.rint(theta_v / step_t), 0, BIN_THETA.size - 1).astype(int)

@@ -45,42 +45,42 @@ CELL = 48
 
 
 def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None):
-    """[(label, paint, rendered error, predicted error, bins, Cycles error or
-    None)] for (label, lut.Paint) ``paints``, their materials baked in
-    ``directory``; ``raw``: a dict to receive each paint's samples."""
-    import bpy
-
-    import addon
+    """Per (label, lut.Paint) of ``paints`` (materials baked in
+    ``directory``): {"label", "paint", "eevee" (rendered error), "eevee_fit"
+    (the error the fit reports), "bins"}, and with ``cycles`` "cycles" (the
+    same spheres in Cycles against the model) and "eevee_vs_cycles" (EEVEE's
+    pixels against Cycles'); ``raw``: a dict to receive each paint's samples.
+    The add-on must be registered."""
     from addon import api
     from scripts.calibrate_eevee import SphereScene
 
-    addon.register()
     scene = SphereScene([None] * len(paints), cell=cell)
-    results = []
+    rows = []
     for sphere, (label, paint) in zip(scene.objects, paints, strict=True):
         material = api.new_material(label, paint, directory=directory)
         sphere.data.materials.append(material)
-        results.append(api.fit_errors(material).get("EEVEE", (None,))[0])
+        rows.append({"label": label, "paint": paint, "eevee_fit": api.fit_errors(material).get("EEVEE", (None,))[0]})
     samples = _sweep(scene, gammas)
     cycles_samples = None
     if cycles:
+        engine = scene.scene.render.engine
         scene.scene.render.engine = "CYCLES"
-        scene.scene.cycles.samples = 16
+        scene.scene.cycles.device = "CPU"
+        scene.scene.cycles.samples = 1  # exact: a delta Sun, every closure evaluated per light sample
         scene.scene.cycles.use_denoising = False
         cycles_samples = _sweep(scene, gammas)
-        scene.scene.render.engine = "BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else "BLENDER_EEVEE_NEXT"
-    out = []
-    for i, (label, paint) in enumerate(paints):
+        scene.scene.render.engine = engine
+    for i, row in enumerate(rows):
         tl, tv, ph, rgb = samples[i]
-        model = paint.brdf(tl, tv, ph) * np.cos(tl)[:, None]
-        error, bins = bench.binned_error(tl, tv, ph, rgb, model)
+        model = row["paint"].brdf(tl, tv, ph) * np.cos(tl)[:, None]
+        row["eevee"], row["bins"] = bench.binned_error(tl, tv, ph, rgb, model)
         if raw is not None:
-            raw[label] = (tl, tv, ph, rgb, model)
-        versus = None
+            raw[row["label"]] = (tl, tv, ph, rgb, model)
         if cycles_samples is not None:
-            versus = _versus(samples[i], cycles_samples[i])
-        out.append((label, paint, error, results[i], bins, versus))
-    return out
+            crgb = cycles_samples[i][3]
+            row["cycles"] = bench.binned_error(tl, tv, ph, crgb, model)[0]
+            row["eevee_vs_cycles"] = bench.binned_error(tl, tv, ph, rgb, crgb)[0]
+    return rows
 
 
 def _sweep(scene, gammas):
@@ -92,18 +92,11 @@ def _sweep(scene, gammas):
     return [tuple(np.concatenate([x[j] for x in s]) for j in range(4)) for s in per]
 
 
-def _versus(eevee_samples, cycles_samples):
-    """EEVEE's pixels against Cycles' (the same pixels, the same geometry):
-    the binned relative RMS with Cycles as the reference."""
-    tl, tv, ph, rgb = eevee_samples
-    return bench.binned_error(tl, tv, ph, rgb, cycles_samples[3])[0]
-
-
-def summary(rows):
-    """{class: (worst, median, count)} of the rendered errors, smooth and rough."""
+def summary(rows, key="eevee"):
+    """{class: (worst, median, count)} of ``key`` over the rows, smooth and rough."""
     out = {}
     for name, rough in (("smooth", False), ("rough", True)):
-        values = [r[2] for r in rows if (r[1].slope > 0) == rough]
+        values = [r[key] for r in rows if (r["paint"].slope > 0) == rough and r.get(key) is not None]
         if values:
             out[name] = (max(values), float(np.median(values)), len(values))
     return out
@@ -119,29 +112,36 @@ def main(argv=None) -> int:
     parser.add_argument("--seed", type=int, default=2026)
     parser.add_argument("--cycles", action="store_true", help="also render the spheres in Cycles: EEVEE vs Cycles")
     parser.add_argument("--out", type=pathlib.Path, default=default_out)
+    parser.add_argument("--luts", type=pathlib.Path, help="bake into (and reuse) this folder, not a temporary one")
     args = parser.parse_args(argv)
     paints = bench.random_paints(args.random, args.seed)
+    import addon
+
+    addon.register()
     start = time.time()
     with tempfile.TemporaryDirectory() as tmp:
-        rows = measure(paints, pathlib.Path(tmp), cycles=args.cycles)
+        rows = measure(paints, args.luts or pathlib.Path(tmp), cycles=args.cycles)
     report = {"blender": version, "seed": args.seed, "paints": {}}
-    for label, paint, error, predicted, bins, versus in rows:
-        report["paints"][label] = {
-            "rough": paint.slope > 0,
-            "eevee": error,
-            "eevee_fit": predicted,
-            "bins": bins,
-            "eevee_vs_cycles": versus,
+    for row in rows:
+        report["paints"][row["label"]] = {
+            "rough": row["paint"].slope > 0,
+            **{k: row.get(k) for k in ("eevee", "eevee_fit", "bins", "cycles", "eevee_vs_cycles")},
         }
-        extra = "" if versus is None else f"  vs Cycles {versus:6.2%}"
-        shown = "" if predicted is None else f"{predicted:6.2%}"
-        print(f"{label:28s} EEVEE {error:6.2%}  fit reports {shown}  ({bins} bins){extra}", flush=True)
+        shown = "" if row["eevee_fit"] is None else f"{row['eevee_fit']:6.2%}"
+        extra = ""
+        if "cycles" in row:
+            extra = f"  Cycles {row['cycles']:6.2%}  EEVEE vs Cycles {row['eevee_vs_cycles']:6.2%}"
+        print(f"{row['label']:28s} EEVEE {row['eevee']:6.2%}  fit reports {shown}  ({row['bins']} bins){extra}")
     targets = fitting.TARGET_ERROR["EEVEE"]
     report["summary"] = {}
-    for name, (worst, median, count) in summary(rows).items():
-        report["summary"][name] = {"worst": worst, "median": median, "count": count}
-        met = sum(1 for r in rows if (r[1].slope > 0) == (name == "rough") and r[2] <= targets[name])
-        print(f"{name:6s} n={count:2d} worst {worst:.2%} median {median:.2%}; {met} within {targets[name]:.0%}")
+    for key in ("eevee", "cycles", "eevee_vs_cycles"):
+        for name, (worst, median, count) in summary(rows, key).items():
+            report["summary"][f"{key} {name}"] = {"worst": worst, "median": median, "count": count}
+            met = sum(1 for r in rows if (r["paint"].slope > 0) == (name == "rough") and r[key] <= targets[name])
+            print(
+                f"{key:16s} {name:6s} n={count:2d} worst {worst:.2%} median {median:.2%};"
+                f" {met} within {targets[name]:.0%}"
+            )
     lutfile.atomic_write_bytes(args.out, (json.dumps(report, indent=2) + "\n").encode())
     print(f"Blender {version}: {len(rows)} paints in {time.time() - start:.0f} s; wrote {args.out}")
     return 0

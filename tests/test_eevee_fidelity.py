@@ -1,0 +1,42 @@
+"""The dense fidelity measure (lut.bench.binned_error) and, with bpy, the
+EEVEE and Cycles renders of a randomised set of paints measured with it
+(scripts/eevee_fidelity.py: every paint on its own sphere, one sweep of
+light angles)."""
+
+import numpy as np
+import pytest
+
+from lut import bench
+
+
+def _samples(count=20000, seed=3):
+    rng = np.random.default_rng(seed)
+    tl = rng.uniform(0, np.radians(80), count)
+    tv = rng.uniform(0, np.radians(80), count)
+    ph = rng.uniform(-np.pi, np.pi, count)
+    model = np.stack([np.cos(tl) * (1 + np.cos(ph) * np.sin(tv))] * 3, axis=-1)
+    return tl, tv, ph, model
+
+
+def test_binned_error_is_the_relative_rms_of_bin_means():
+    tl, tv, ph, model = _samples()
+    assert bench.binned_error(tl, tv, ph, model, model)[0] == 0.0
+    # A uniform 10% excess is a 10% error, whatever the binning.
+    assert bench.binned_error(tl, tv, ph, 1.1 * model, model)[0] == pytest.approx(0.1, rel=1e-12)
+    # Noise that averages out within bins hardly counts; a bias does.
+    rng = np.random.default_rng(0)
+    noisy = model * (1 + 0.05 * rng.choice([-1.0, 1.0], model.shape))
+    assert bench.binned_error(tl, tv, ph, noisy, model)[0] < 0.03
+
+
+def test_binned_error_leaves_out_the_mirror_and_what_the_measure_does_not_cover():
+    tl, tv, ph, model = _samples()
+    near = bench.mirror_distance(tl, tv, ph) < bench.MIRROR_DISTANCE
+    off_range = (tl > np.radians(78)) | (tv > np.radians(78)) | (np.abs(ph) < np.radians(12))
+    assert near.any() and off_range.any()
+    spoiled = np.where((near | off_range)[:, None], 100 * model, model)
+    assert bench.binned_error(tl, tv, ph, spoiled, model)[0] == 0.0
+    assert bench.mirror_distance(0.3, 0.3, 0.0) == pytest.approx(0.0, abs=1e-7)
+    assert bench.mirror_distance(0.0, 0.2, 1.0) == pytest.approx(0.2)
+    with pytest.raises(ValueError, match="no bin"):
+        bench.binned_error(tl[:2], tv[:2], ph[:2], model[:2], model[:2])
