@@ -13,9 +13,12 @@ A library material carries its paint (``material.paint_lut``) and a
 Principled fallback (``export``) but no bake: its LUT and fits would name
 files on the machine that made the library.  It is flagged ``FIRST_USE``;
 once it is in a file (dropped on an object, appended, or in a file opened),
-a depsgraph or load handler schedules ``bake_pending``, which bakes it with
-``api.bake_material`` into ``api.lut_directory()`` (beside the saved .blend,
-or the extension's user folder for an unsaved file) and clears the flag."""
+a depsgraph or load handler schedules a timer that bakes it in the
+background (``jobs.BakeJob``, like the panel's Bake) into
+``api.lut_directory()`` (beside the saved .blend, or the extension's user
+folder for an unsaved file), wires it and clears the flag.  Scripts, which
+have no event loop to run timers, call ``bake_pending`` (blocking, through
+``api.bake_material``)."""
 
 from __future__ import annotations
 
@@ -25,7 +28,7 @@ import pathlib
 import bpy
 from bpy.app.handlers import persistent
 
-from . import api
+from . import api, jobs, nodes
 
 #: The asset library's folder, its .blend and its name in the Preferences.
 ASSETS = pathlib.Path(__file__).resolve().parent / "assets"
@@ -105,6 +108,8 @@ def bake_pending(directory=None) -> dict:
     if _is_library_file():
         return status
     for material in pending():
+        if material.name in _jobs:  # the interactive path is baking it already
+            continue
         try:
             api.bake_material(material, directory=directory)
             status[material.name] = "baked"
@@ -112,9 +117,8 @@ def bake_pending(directory=None) -> dict:
                 del material[ERROR]
         except (ValueError, OSError, RuntimeError, TypeError, KeyError) as exc:
             reason = str(exc) or type(exc).__name__
-            material[ERROR] = reason
+            _fail(material, reason)
             status[material.name] = f"failed: {reason}"
-            print(f"Paint LUT: first bake of {material.name!r} failed: {reason}")
         del material[FIRST_USE]
     if status:
         _redraw()
@@ -128,14 +132,79 @@ def _redraw():
             area.tag_redraw()
 
 
+#: Seconds between the timer's looks at running first-use bakes.
+POLL = 0.25
+
+#: First-use bakes running in the background: {material name: (BakeJob, paint, type key at start)}.
+_jobs = {}
+
+
+def _fail(material, reason):
+    material[ERROR] = reason
+    print(f"Paint LUT: first bake of {material.name!r} failed: {reason}")
+
+
+def _finish_jobs():
+    """Wire the bakes that finished into their materials (if those still wait for them)."""
+    for name, (job, paint, type_key) in list(_jobs.items()):
+        if not job.done:
+            continue
+        del _jobs[name]
+        material = bpy.data.materials.get(name)
+        if material is None or material.library is not None or not material.get(FIRST_USE):
+            continue  # removed, renamed or baked meanwhile: the next look starts it again if it still waits
+        if job.error:
+            _fail(material, job.error)
+        else:
+            api.finish_background_bake(material, paint, job.result, type_key)
+            if ERROR in material:
+                del material[ERROR]
+        del material[FIRST_USE]
+        _redraw()
+
+
+def _start_next():
+    """Start the first-use bake of one waiting material (one at a time: the
+    bake already uses every core, and materials of one type then share it)."""
+    for material in pending():
+        if material.name in _jobs:
+            continue
+        try:
+            paint = api.paint_of(material)
+        except ValueError as exc:
+            _fail(material, str(exc))
+            del material[FIRST_USE]
+            continue
+        job = jobs.BakeJob(
+            paint, api.lut_directory(), exact_metallic=nodes.EXACT_METALLIC, targets=api.engine_targets(),
+            eevee_calibration=api.eevee_calibration(),
+        ).start()  # fmt: skip
+        _jobs[material.name] = (job, paint, material.paint_lut.type_key())
+        return
+
+
 def _on_timer():
-    bake_pending()
-    return None  # once
+    """The interactive first-use path: bakes run on a worker thread
+    (``jobs.BakeJob``, as the panel's Bake) so the interface never waits;
+    each finished one is wired with ``api.finish_background_bake``.  Returns
+    the next interval while anything runs or waits, else None (stop)."""
+    if _is_library_file():
+        return None
+    _finish_jobs()
+    if not _jobs:
+        _start_next()
+    return POLL if _jobs or pending() else None
+
+
+def _cancel_jobs():
+    for job, _paint, _key in _jobs.values():
+        job.cancel()
+    _jobs.clear()
 
 
 def schedule() -> bool:
-    """Bake the pending materials soon (from a timer, outside the handler
-    that noticed them).  Returns whether anything is pending."""
+    """Bake the waiting materials soon (from a timer, outside the handler
+    that noticed them).  Returns whether anything waits."""
     if not pending() or _is_library_file():
         return False
     if not bpy.app.timers.is_registered(_on_timer):
@@ -147,6 +216,11 @@ def schedule() -> bool:
 def _on_depsgraph_update(scene, depsgraph=None):
     if depsgraph is None or depsgraph.id_type_updated("MATERIAL") or depsgraph.id_type_updated("OBJECT"):
         schedule()
+
+
+@persistent
+def _on_load_pre(*_args):
+    _cancel_jobs()  # their materials belong to the file being closed
 
 
 @persistent
@@ -163,6 +237,7 @@ def _on_factory_preferences(*_args):
 
 HANDLERS = (
     (bpy.app.handlers.depsgraph_update_post, _on_depsgraph_update),
+    (bpy.app.handlers.load_pre, _on_load_pre),
     (bpy.app.handlers.load_post, _on_load),
     (bpy.app.handlers.load_factory_preferences_post, _on_factory_preferences),
 )
@@ -181,4 +256,5 @@ def unregister():
             handlers.remove(handler)
     if bpy.app.timers.is_registered(_on_timer):
         bpy.app.timers.unregister(_on_timer)
+    _cancel_jobs()
     unregister_library()

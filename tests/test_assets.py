@@ -177,3 +177,16 @@ def test_a_failed_first_bake_is_recorded_not_raised(fresh_file, lut_dir):
     assert status["Glossy White"].startswith("failed: ")
     assert library.FIRST_USE not in material and "spectral" in material[library.ERROR]
     assert library.pending() == []
+
+
+def test_the_interactive_first_use_bakes_in_the_background(fresh_file):
+    """What the timer does in a session: start a background bake (the
+    interface does not wait), then wire its result once it is done."""
+    from addon import api, library
+
+    material = _load({"Glossy White"})["Glossy White"]
+    assert library._on_timer() == library.POLL  # started, polling
+    job = library._jobs["Glossy White"][0]
+    assert job.wait(300) and not job.error
+    assert library._on_timer() is None  # finished: nothing runs or waits
+    _assert_working(material, api.lut_directory())
