@@ -125,6 +125,8 @@ INSTALLED = textwrap.dedent(
     api = importlib.import_module("bl_ext.user_default.paint_lut.api")
     seam = importlib.import_module("bl_ext.user_default.paint_lut._lut")
     print("SEAM_FROM", seam.lut.__file__)
+    libraries = bpy.context.preferences.filepaths.asset_libraries
+    print("ASSET_LIBRARY", *[lib.path for lib in libraries if lib.name == "Paint LUT"])
     print("API_LUT", api.lut.__name__)
     material = bpy.data.materials.new("paint")
     material.paint_lut.preset = "glossy_red"
@@ -170,6 +172,10 @@ def test_installs_offline_into_a_clean_user_directory_and_renders(package, tmp_p
     assert pathlib.Path(out["LUT_FROM"]).is_relative_to(resources)
     assert out["SEAM_FROM"] == out["LUT_FROM"]
     assert out["API_LUT"] == "paint_lut_core"
+    # The bundled asset library is registered from where the extension was installed.
+    installed = resources / "extensions" / "user_default" / "paint_lut"
+    assert pathlib.Path(out["ASSET_LIBRARY"]) == installed / "assets"
+    assert (installed / "assets" / "paint_lut_library.blend").is_file()
     assert pathlib.Path(out["ADDON_FROM"]).is_relative_to(resources / "extensions" / "user_default" / "paint_lut")
     assert out["LUT_PATH"].startswith("//paint_lut/")
     assert (tmp_path / out["LUT_PATH"][2:]).exists()
