@@ -1,6 +1,16 @@
 """Make the bundled paint library: addon/assets/ and its pictures.
 
-    .venv/bin/python scripts/make_assets.py [--samples N] [--size PX]
+    python scripts/make_assets.py [--samples N] [--size PX]
+
+run by Blender 4.2's Python module (the oldest supported Blender; see
+``OLDEST``), e.g. in a Python 3.11 virtual environment made for it:
+
+    python3.11 -m venv .venv-bpy42
+    .venv-bpy42/bin/pip install bpy==4.2.0 numpy==1.26.4 matplotlib==3.10.7
+    .venv-bpy42/bin/python scripts/make_assets.py
+
+(pip bpy 4.2 ends with a segmentation fault at interpreter exit in any
+script that registered the add-on; everything is written before.)
 
 For every paint of ``lut.presets.LIBRARY`` (the paper's three samples, then
 the common finishes) this writes a material into
@@ -42,6 +52,11 @@ NAMESPACE = uuid.UUID("6f1f7d1c-3b0e-4b8e-9a55-2c1d0e7f4a10")
 NAMES = {"glossy_white": "Glossy White", "glossy_red": "Glossy Red", "green_carc": "Green CARC"}
 
 FIGURES = ROOT / "docs" / "figures"
+
+#: The oldest Blender the extension supports (blender_manifest.toml): the
+#: library is written by it, because a file saved by Blender 5 does not
+#: open in 4.2 ("not a blend file") while 4.2's files open in every later one.
+OLDEST = (4, 2)
 
 
 def paints():
@@ -94,8 +109,9 @@ def library_material(name: str):
     first-use flag, asset metadata.  Not baked."""
     paint = presets.library_paint(name)
     material = bpy.data.materials.new(display_name(name))
-    if material.node_tree is not None:  # Blender 5's default Principled BSDF: the fallback replaces it
-        material.node_tree.nodes.clear()
+    if material.node_tree is None:  # Blender 4.x: a new material has no node tree yet
+        material.use_nodes = True
+    material.node_tree.nodes.clear()  # the default Principled BSDF: the fallback replaces it
     api.set_paint(material, paint)
     material.paint_lut.enabled = True
     export.update_fallback(material, api.paint_of(material))
@@ -227,7 +243,16 @@ def main(argv=None) -> int:
     parser.add_argument("--size", type=int, default=128, help="preview size in pixels")
     parser.add_argument("--assets", default=str(library.ASSETS), help="the asset library folder")
     parser.add_argument("--figures", default=str(FIGURES), help="where the pictures go")
+    parser.add_argument(
+        "--allow-newer", action="store_true",
+        help=f"write the library with this Blender although files of Blender newer than {OLDEST} do not open in it",
+    )  # fmt: skip
     args = parser.parse_args(argv)
+    if bpy.app.version[:2] != OLDEST and not args.allow_newer:
+        raise SystemExit(
+            f"error: run this with Blender {OLDEST[0]}.{OLDEST[1]} (pip bpy=={OLDEST[0]}.{OLDEST[1]}.0, Python 3.11): "
+            f"the library must open in every supported Blender and this is {bpy.app.version_string}"
+        )
     assets, figures = pathlib.Path(args.assets), pathlib.Path(args.figures)
     (figures / "library").mkdir(parents=True, exist_ok=True)
     assets.mkdir(parents=True, exist_ok=True)

@@ -105,6 +105,22 @@ def test_library_file_holds_one_asset_per_paint_with_a_preview(fresh_file):
         assert api.paint_of(material) == presets.library_paint(name, api.paint_of(material).space)
 
 
+def test_library_file_is_written_by_the_oldest_supported_blender(fresh_file):
+    """Blender 4.2 cannot read a file saved by Blender 5, so the library is
+    written by the manifest's minimum version (make_assets.OLDEST)."""
+    import tomllib
+
+    import bpy
+
+    make_assets = _make_assets()
+    minimum = tomllib.loads((ROOT / "blender_manifest.toml").read_text())["blender_version_min"]
+    assert tuple(int(v) for v in minimum.split(".")[:2]) == make_assets.OLDEST
+    with bpy.data.libraries.load(str(BLEND), link=True) as (source, target):
+        target.materials = source.materials[:1]
+    library = next(lib for lib in bpy.data.libraries if pathlib.Path(lib.filepath).resolve() == BLEND.resolve())
+    assert tuple(library.version[:2]) == make_assets.OLDEST
+
+
 def test_registering_adds_the_asset_library_and_unregistering_removes_it(addon_registered):
     import bpy
 
