@@ -206,3 +206,30 @@ def test_the_interactive_first_use_bakes_in_the_background(fresh_file):
     assert job.wait(300) and not job.error
     assert library._on_timer() is None  # finished: nothing runs or waits
     _assert_working(material, api.lut_directory())
+
+
+def test_a_saved_file_bakes_beside_itself_and_its_waiting_materials_are_found_on_load(fresh_file, tmp_path):
+    """Open a saved file with a library material still waiting: the load
+    handler schedules its bake, which goes to //paint_lut beside the file.
+    Opening the library file itself schedules nothing (its bakes would land
+    in the add-on's folder)."""
+    import bpy
+
+    from addon import library
+
+    _load({"Glossy White"})
+    blend = tmp_path / "scene.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend))
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    assert bpy.app.timers.is_registered(library._on_timer)
+    bpy.app.timers.unregister(library._on_timer)
+    material = bpy.data.materials["Glossy White"]
+    assert library.bake_pending() == {"Glossy White": "baked"}
+    assert material.paint_lut.lut_path.startswith("//paint_lut/")
+    _assert_working(material, tmp_path / "paint_lut")
+
+    bpy.ops.wm.open_mainfile(filepath=str(BLEND))
+    assert library.pending() and not library.schedule()
+    assert not bpy.app.timers.is_registered(library._on_timer)
+    assert library.bake_pending() == {}
