@@ -3,13 +3,15 @@
 Properties, panels, operators, node building and batch baking live here; all
 physics and file formats are in ``lut``.  A bake writes the paint's LUT and
 per-view closure fits (Cycles, EEVEE) and wires them into the material as
-node groups (``nodes``); ``api`` and ``batch`` are the headless entry points."""
+node groups (``nodes``); ``api`` and ``batch`` are the headless entry points.
+``library`` registers the bundled paint materials as an asset library and
+bakes each one on its first use."""
 
 import bpy
 
-from . import operators, panels, properties
+from . import library, operators, panels, properties
 
-_MODULES = (properties, operators, panels)
+_MODULES = (properties, operators, panels, library)
 
 
 def _expose_openimageio():

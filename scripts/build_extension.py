@@ -3,7 +3,8 @@
     .venv/bin/python scripts/build_extension.py [--output-dir dist] [--blender PATH]
 
 The zip holds the add-on (addon/*.py, relative imports) with the repository's
-blender_manifest.toml, and the library as a wheel of its own
+blender_manifest.toml, its bundled asset library (addon/assets/: the paint
+materials' .blend and its catalogs), and the library as a wheel of its own
 (wheels/paint_lut-<version>-py3-none-any.whl).  Blender installs bundled
 wheels into the extensions' shared site-packages, where another extension's
 top-level ``lut`` could clash with ours, so the wheel's package is the
@@ -43,6 +44,9 @@ PACKAGE = "paint_lut_core"
 #: lut modules the wheel leaves out: matplotlib plots (figures, and examples,
 #: which draws them) and benchmarks; the CLI's ``example`` command says so.
 DEV_ONLY = ("bench.py", "examples.py", "figures.py", "models/reference.py")
+
+#: The asset library's files (scripts/make_assets.py), packed under assets/.
+ASSETS = ("paint_lut_library.blend", "blender_assets.cats.txt")
 
 #: zip entries get this fixed time, so the same sources give the same wheel.
 EPOCH = (1980, 1, 1, 0, 0, 0)
@@ -120,11 +124,16 @@ def build_wheel(directory: pathlib.Path) -> pathlib.Path:
 
 
 def stage(directory: pathlib.Path) -> pathlib.Path:
-    """The extension's source folder: add-on modules, manifest and wheel."""
+    """The extension's source folder: add-on modules, asset library, manifest and wheel."""
     source = directory / "paint_lut"
     (source / "wheels").mkdir(parents=True)
     for module in sorted((ROOT / "addon").glob("*.py")):
         shutil.copy2(module, source / module.name)
+    # The bundled asset library (addon/library.py registers the folder).
+    assets = ROOT / "addon" / "assets"
+    (source / "assets").mkdir()
+    for name in ASSETS:
+        shutil.copy2(assets / name, source / "assets" / name)
     shutil.copy2(ROOT / "blender_manifest.toml", source / "blender_manifest.toml")
     build_wheel(source / "wheels")
     return source

@@ -31,7 +31,8 @@ def test_zip_holds_the_add_on_manifest_and_lut_wheel(package):
         wheel = manifest["wheels"][0].removeprefix("./")
         # The one permission says what is written, where, and why.
         assert ".blend" in manifest["permissions"]["files"] and "reuse" in manifest["permissions"]["files"]
-        assert {"__init__.py", "api.py", "nodes.py", "properties.py", wheel} <= names
+        assert {"__init__.py", "api.py", "nodes.py", "properties.py", "library.py", wheel} <= names
+        assert {"assets/paint_lut_library.blend", "assets/blender_assets.cats.txt"} <= names
         assert not any(name.startswith(("lut/", "tests/", "scripts/")) or "__pycache__" in name for name in names)
         with zipfile.ZipFile(archive.open(wheel)) as inner:
             files = set(inner.namelist())
@@ -124,6 +125,8 @@ INSTALLED = textwrap.dedent(
     api = importlib.import_module("bl_ext.user_default.paint_lut.api")
     seam = importlib.import_module("bl_ext.user_default.paint_lut._lut")
     print("SEAM_FROM", seam.lut.__file__)
+    libraries = bpy.context.preferences.filepaths.asset_libraries
+    print("ASSET_LIBRARY", *[lib.path for lib in libraries if lib.name == "Paint LUT"])
     print("API_LUT", api.lut.__name__)
     material = bpy.data.materials.new("paint")
     material.paint_lut.preset = "glossy_red"
@@ -169,6 +172,10 @@ def test_installs_offline_into_a_clean_user_directory_and_renders(package, tmp_p
     assert pathlib.Path(out["LUT_FROM"]).is_relative_to(resources)
     assert out["SEAM_FROM"] == out["LUT_FROM"]
     assert out["API_LUT"] == "paint_lut_core"
+    # The bundled asset library is registered from where the extension was installed.
+    installed = resources / "extensions" / "user_default" / "paint_lut"
+    assert pathlib.Path(out["ASSET_LIBRARY"]) == installed / "assets"
+    assert (installed / "assets" / "paint_lut_library.blend").is_file()
     assert pathlib.Path(out["ADDON_FROM"]).is_relative_to(resources / "extensions" / "user_default" / "paint_lut")
     assert out["LUT_PATH"].startswith("//paint_lut/")
     assert (tmp_path / out["LUT_PATH"][2:]).exists()
