@@ -31,7 +31,7 @@ def test_zip_holds_the_add_on_manifest_and_lut_wheel(package):
         wheel = manifest["wheels"][0].removeprefix("./")
         # The one permission says what is written, where, and why.
         assert ".blend" in manifest["permissions"]["files"] and "reuse" in manifest["permissions"]["files"]
-        assert {"__init__.py", "api.py", "nodes.py", "properties.py", wheel} <= names
+        assert {"__init__.py", "api.py", "batch.py", "nodes.py", "properties.py", wheel} <= names
         assert not any(name.startswith(("lut/", "tests/", "scripts/")) or "__pycache__" in name for name in names)
         with zipfile.ZipFile(archive.open(wheel)) as inner:
             files = set(inner.namelist())
