@@ -1,6 +1,6 @@
 """The extension zip (scripts/build_extension.py): built and validated by
 Blender's own builder, then installed into a clean Blender user directory
-with no network, where a preset is baked and rendered."""
+with no network, where a preset is baked and rendered by the shipped oracle."""
 
 import importlib.util
 import os
@@ -31,7 +31,7 @@ def test_zip_holds_the_add_on_manifest_and_lut_wheel(package):
         wheel = manifest["wheels"][0].removeprefix("./")
         # The one permission says what is written, where, and why.
         assert ".blend" in manifest["permissions"]["files"] and "reuse" in manifest["permissions"]["files"]
-        assert {"__init__.py", "api.py", "batch.py", "nodes.py", "properties.py", wheel} <= names
+        assert {"__init__.py", "api.py", "batch.py", "nodes.py", "properties.py", "scenes.py", wheel} <= names
         assert not any(name.startswith(("lut/", "tests/", "scripts/")) or "__pycache__" in name for name in names)
         with zipfile.ZipFile(archive.open(wheel)) as inner:
             files = set(inner.namelist())
@@ -110,14 +110,14 @@ INSTALLED = textwrap.dedent(
     """
     import importlib, math, sys
     sys.path.insert(0, {foreign!r})  # another extension's top-level lut
-    sys.path.insert(0, {tests!r})
-    from blender_oracle import Oracle  # test harness only; not the add-on
-    oracle = Oracle()  # factory settings first: they would reset the preferences
     import bpy
+    bpy.ops.wm.read_factory_settings(use_empty=True)  # first: it resets the preferences
     result = bpy.ops.extensions.package_install_files(
         filepath={zip!r}, repo="user_default", enable_on_install=True
     )
     assert result == {{"FINISHED"}}, result
+    scenes = importlib.import_module("bl_ext.user_default.paint_lut.scenes")
+    oracle = scenes.Oracle(reset=False)  # the shipped oracle, in the empty file
     import lut as foreign
     assert foreign.FOREIGN, "the foreign lut is first on sys.path"
     import paint_lut_core as lut
@@ -148,9 +148,7 @@ def test_installs_offline_into_a_clean_user_directory_and_renders(package, tmp_p
     foreign = tmp_path / "foreign"
     (foreign / "lut").mkdir(parents=True)
     (foreign / "lut" / "__init__.py").write_text("FOREIGN = True\n")
-    code = INSTALLED.format(
-        tests=str(ROOT / "tests"), foreign=str(foreign), zip=str(package), blend=str(tmp_path / "scene.blend")
-    )
+    code = INSTALLED.format(foreign=str(foreign), zip=str(package), blend=str(tmp_path / "scene.blend"))
     env = {k: v for k, v in os.environ.items() if k not in {"PYTHONPATH", "BLENDER_USER_SCRIPTS"}}
     env.update(
         BLENDER_USER_RESOURCES=str(resources),
