@@ -155,14 +155,14 @@ def test_glossy_black_bakes_and_renders_only_its_mirror(material, lut_dir):
     assert any(nd.type == "BSDF_METALLIC" and nd.label.startswith("Mirror") for nd in group.nodes)
 
 
-def test_bake_operator_runs_headless(material, lut_dir, monkeypatch):
-    from addon import api
-
-    monkeypatch.setattr(api, "lut_directory", lambda: lut_dir)  # the operator bakes where the file says
+def test_bake_operator_runs_headless(material, tmp_path):
+    """The operator bakes where the file says: next to the saved .blend."""
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "scene.blend"))
     material.paint_lut.preset = "glossy_white"
     with bpy.context.temp_override(material=material):
         assert bpy.ops.paint_lut.bake("EXEC_DEFAULT") == {"FINISHED"}
     assert not material.paint_lut.stale and material.paint_lut.lut_path.endswith(".exr")
+    assert (tmp_path / material.paint_lut.lut_path.removeprefix("//")).is_file()
 
 
 def test_background_job_reports_progress_and_cancels_anywhere(tmp_path):
