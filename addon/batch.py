@@ -85,11 +85,11 @@ def _report_name(material) -> str:
     return material.name if material.library is None else material.name_full
 
 
-def linked_status(material) -> dict:
+def linked_status(material, exact_metallic=None) -> dict:
     """The report entry of a material linked from a library: where to bake
     it and whether that library holds a current bake (the settings are not
-    stale, and the LUT, both weights files and the node groups are there and
-    verified)."""
+    stale, and the LUT, both weights files, for ``exact_metallic`` lobes as
+    in ``api.bake_material``, and the node groups are there and verified)."""
     library = pathlib.Path(bpy.path.abspath(material.library.filepath)).resolve()
     settings = material.paint_lut
     baked = False
@@ -97,8 +97,9 @@ def linked_status(material) -> dict:
         path = pathlib.Path(bpy.path.abspath(settings.lut_path, library=material.library))
         try:
             table = lut.load_lut(path)
+            exact = nodes.exact_metallic_default(exact_metallic)
             for target in closures.TARGETS:
-                fitted = fitting.read_fit(fitting.fit_path(path, target, nodes.EXACT_METALLIC, api.eevee_calibration()))
+                fitted = fitting.read_fit(fitting.fit_path(path, target, exact, api.eevee_calibration()))
                 baked_node = nodes.group_of(material, target)
                 if fitted.lut_key != table.key or baked_node is None or not nodes.is_paint_group(baked_node.node_tree):
                     raise lut.LUTError("not wired to this bake")
@@ -115,7 +116,7 @@ def bake_one(material, used, force=False, **options) -> dict:
     """Bake one paint material if it is used and not current; its report
     entry.  Any exception fails this material alone, with its reason."""
     if material.library is not None:
-        return linked_status(material) if material in used else {"status": "unused"}
+        return linked_status(material, options.get("exact_metallic")) if material in used else {"status": "unused"}
     if material not in used:
         return {"status": "unused"}
     try:
