@@ -1,6 +1,7 @@
 """The extension zip (scripts/build_extension.py): built and validated by
 Blender's own builder, then installed into a clean Blender user directory
-with no network, where a preset is baked and rendered by the shipped oracle."""
+with no network, where a preset is baked and rendered by the shipped oracle
+and the shipped batch command finds the saved file's bake current."""
 
 import importlib.util
 import os
@@ -108,7 +109,7 @@ def test_manifest_and_versions_agree():
 
 INSTALLED = textwrap.dedent(
     """
-    import importlib, math, sys
+    import importlib, json, math, sys
     sys.path.insert(0, {foreign!r})  # another extension's top-level lut
     import bpy
     bpy.ops.wm.read_factory_settings(use_empty=True)  # first: it resets the preferences
@@ -139,6 +140,10 @@ INSTALLED = textwrap.dedent(
     print("LUT_PATH", material.paint_lut.lut_path)
     print("RENDERED", *rendered)
     print("MODEL", *model)
+    bpy.ops.wm.save_mainfile()
+    batch = importlib.import_module("bl_ext.user_default.paint_lut.batch")  # the shipped farm command
+    code = batch.main([{blend!r}, "--report", {report!r}])
+    print("BATCH", code, json.load(open({report!r}))[0]["materials"]["paint"]["status"])
     """
 )
 
@@ -148,7 +153,9 @@ def test_installs_offline_into_a_clean_user_directory_and_renders(package, tmp_p
     foreign = tmp_path / "foreign"
     (foreign / "lut").mkdir(parents=True)
     (foreign / "lut" / "__init__.py").write_text("FOREIGN = True\n")
-    code = INSTALLED.format(foreign=str(foreign), zip=str(package), blend=str(tmp_path / "scene.blend"))
+    code = INSTALLED.format(
+        foreign=str(foreign), zip=str(package), blend=str(tmp_path / "scene.blend"), report=str(tmp_path / "bake.json")
+    )
     env = {k: v for k, v in os.environ.items() if k not in {"PYTHONPATH", "BLENDER_USER_SCRIPTS"}}
     env.update(
         BLENDER_USER_RESOURCES=str(resources),
@@ -170,6 +177,7 @@ def test_installs_offline_into_a_clean_user_directory_and_renders(package, tmp_p
     assert pathlib.Path(out["ADDON_FROM"]).is_relative_to(resources / "extensions" / "user_default" / "paint_lut")
     assert out["LUT_PATH"].startswith("//paint_lut/")
     assert (tmp_path / out["LUT_PATH"][2:]).exists()
+    assert out["BATCH"] == "0 cached"  # the file's material, baked above, found current
     rendered = [float(v) for v in out["RENDERED"].split()]
     model = [float(v) for v in out["MODEL"].split()]
     for r, m in zip(rendered, model, strict=True):
