@@ -4,8 +4,9 @@
 
 Three spheres on a grey floor (addon.scenes.presets_scene), each material
 made by the add-on's headless API (addon.api.new_material: bake, closure
-fit, node groups), lit by a Sun and a soft sky; Filmic-free 'Standard' view so the paint colours are shown
-as rendered.  The LUTs go to a temporary folder."""
+fit, node groups), lit by a Sun and a soft sky; Filmic-free 'Standard' view
+so the paint colours are shown as rendered.  The LUTs go to a temporary
+folder."""
 
 from __future__ import annotations
 
