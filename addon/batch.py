@@ -88,8 +88,9 @@ def _report_name(material) -> str:
 def linked_status(material, exact_metallic=None) -> dict:
     """The report entry of a material linked from a library: where to bake
     it and whether that library holds a current bake (the settings are not
-    stale, and the LUT, both weights files, for ``exact_metallic`` lobes as
-    in ``api.bake_material``, and the node groups are there and verified)."""
+    stale, and the LUT, both weights files (of ``exact_metallic`` lobes, as
+    ``api.bake_material`` takes it) and the node groups are there and
+    verified)."""
     library = pathlib.Path(bpy.path.abspath(material.library.filepath)).resolve()
     settings = material.paint_lut
     baked = False
