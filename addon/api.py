@@ -8,6 +8,7 @@ is all a colour edit needs."""
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import json
 import pathlib
@@ -46,19 +47,23 @@ def paint_of(material) -> lut.Paint:
     return material.paint_lut.to_paint(working_space())
 
 
-class BakeStatus(str):
-    """A material's bake status: the text "baked", "cached", "unused",
-    "linked: <where to bake it>" or "failed: <reason>", with attributes
-    ``state`` (the first word), ``reason``, ``errors`` ({engine: fit error
-    at the material's colours}), ``misses`` ({engine: (error, target)} where
-    the fit misses its target) and ``key`` (the paint type's LUT key:
-    materials with the same key shared one bake)."""
+@dataclasses.dataclass(frozen=True)
+class BakeStatus:
+    """A material's bake status: ``state`` ("baked", "cached", "unused" or
+    "failed"), ``reason`` (why it failed), ``errors`` ({engine: fit error at
+    the material's colours}), ``misses`` ({engine: (error, target)} where the
+    fit misses its target) and ``key`` (the paint type's LUT key: materials
+    with the same key shared one bake).  ``str()`` gives the line to show
+    ("failed: <reason>"); read the fields, never that text."""
 
-    def __new__(cls, state, reason="", errors=None, misses=None, key=""):
-        self = super().__new__(cls, f"{state}: {reason}" if reason else state)
-        self.state, self.reason = state, reason
-        self.errors, self.misses, self.key = dict(errors or {}), dict(misses or {}), key
-        return self
+    state: str
+    reason: str = ""
+    errors: dict = dataclasses.field(default_factory=dict)
+    misses: dict = dataclasses.field(default_factory=dict)
+    key: str = ""
+
+    def __str__(self):
+        return f"{self.state}: {self.reason}" if self.reason else self.state
 
 
 def engine_targets():
@@ -339,9 +344,10 @@ def is_current(material, paint, *, directory=None, exact_metallic=None, **option
 
 def bake_materials(used, force=False, *, directory=None, exact_metallic=None, **options) -> dict:
     """Bake the paint materials (those with Use Paint LUT) of the file that
-    are in ``used``.  Returns {material name: BakeStatus}: "baked" (computed
-    or wired anew), "cached" (up to date, nothing computed), "unused"
-    (skipped) or "failed: <reason>" (the material is left as it was).
+    are in ``used``.  Returns {material name: BakeStatus} whose ``state`` is
+    "baked" (computed or wired anew), "cached" (up to date, nothing
+    computed), "unused" (skipped) or "failed" (with its ``reason``; the
+    material is left as it was).
     Materials of one paint type share one bake: the first computes it, the
     others find it cached on disk (``BakeStatus.key`` groups them)."""
     status = {}

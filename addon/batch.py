@@ -1,4 +1,5 @@
-"""Headless batch baking of .blend files (for farms; scripts/batch_bake.py).
+"""Headless batch baking of .blend files, for farms: ``main`` is the command
+line (scripts/batch_bake.py runs it from the repository).
 
 One file at a time: open it, bake the paint materials it renders (what its
 scenes' depsgraphs evaluate: object slots, collection instances, Geometry
@@ -24,8 +25,15 @@ its permissions."""
 
 from __future__ import annotations
 
+import argparse
+import concurrent.futures
+import importlib
+import json
 import os
 import pathlib
+import subprocess
+import sys
+import tempfile
 
 import bpy
 
@@ -77,10 +85,11 @@ def _report_name(material) -> str:
     return material.name if material.library is None else material.name_full
 
 
-def linked_status(material) -> dict:
+def linked_status(material, exact_metallic=None) -> dict:
     """The report entry of a material linked from a library: where to bake
     it and whether that library holds a current bake (the settings are not
-    stale, and the LUT, both weights files and the node groups are there and
+    stale, and the LUT, both weights files (of ``exact_metallic`` lobes, as
+    ``api.bake_material`` takes it) and the node groups are there and
     verified)."""
     library = pathlib.Path(bpy.path.abspath(material.library.filepath)).resolve()
     settings = material.paint_lut
@@ -89,8 +98,9 @@ def linked_status(material) -> dict:
         path = pathlib.Path(bpy.path.abspath(settings.lut_path, library=material.library))
         try:
             table = lut.load_lut(path)
+            exact = nodes.exact_metallic_default(exact_metallic)
             for target in closures.TARGETS:
-                fitted = fitting.read_fit(fitting.fit_path(path, target, nodes.EXACT_METALLIC, api.eevee_calibration()))
+                fitted = fitting.read_fit(fitting.fit_path(path, target, exact, api.eevee_calibration()))
                 baked_node = nodes.group_of(material, target)
                 if fitted.lut_key != table.key or baked_node is None or not nodes.is_paint_group(baked_node.node_tree):
                     raise lut.LUTError("not wired to this bake")
@@ -107,7 +117,7 @@ def bake_one(material, used, force=False, **options) -> dict:
     """Bake one paint material if it is used and not current; its report
     entry.  Any exception fails this material alone, with its reason."""
     if material.library is not None:
-        return linked_status(material) if material in used else {"status": "unused"}
+        return linked_status(material, options.get("exact_metallic")) if material in used else {"status": "unused"}
     if material not in used:
         return {"status": "unused"}
     try:
@@ -213,3 +223,141 @@ def summary(entries) -> str:
         for key, names in entry.get("shared", {}).items():
             lines.append(f"  one bake of paint type {key[:12]} shared by {', '.join(names)}")
     return "\n".join(lines)
+
+
+# ----------------------------------------------------------------------------- the command line
+
+
+def parse(argv):
+    parser = argparse.ArgumentParser(
+        prog="batch_bake.py", description="Bake the paint materials that .blend files use, and save them."
+    )
+    parser.add_argument("files", nargs="+", metavar="SCENE.blend", help=".blend files to bake")
+    parser.add_argument("--force", action="store_true", help="bake even what is up to date")
+    parser.add_argument("--pack", action="store_true", help="pack the weight images into the .blend")
+    parser.add_argument("--report", metavar="FILE", help="write the JSON report here")
+    parser.add_argument("--jobs", type=int, default=1, metavar="N", help="files baked in parallel processes")
+    args = parser.parse_args(argv)
+    if args.jobs < 1:
+        parser.error(f"--jobs must be an integer >= 1, got {args.jobs}")
+    if args.report:
+        problem = report_problem(pathlib.Path(args.report))
+        if problem:
+            parser.error(f"--report {args.report}: {problem}")
+    return args
+
+
+def report_problem(path: pathlib.Path):
+    """Why the report cannot be written there (checked before any work), or None."""
+    if path.is_dir():
+        return "is a directory"
+    parent = path.parent if str(path.parent) else pathlib.Path(".")
+    if not parent.is_dir():
+        return f"no such directory {parent}"
+    if not os.access(parent, os.W_OK | os.X_OK):
+        return f"directory {parent} is not writable"
+    return None
+
+
+def script_argv():
+    """Our arguments: after '--' inside Blender, else the command line's."""
+    if "--" in sys.argv:
+        return sys.argv[sys.argv.index("--") + 1 :]
+    return sys.argv[1:]
+
+
+def progress(items, total):
+    """tqdm's bar on a terminal (when installed); plain items otherwise."""
+    if sys.stderr.isatty():
+        try:
+            from tqdm import tqdm
+
+            return tqdm(items, total=total, unit="file", desc="baking")
+        except ImportError:
+            pass
+    return items
+
+
+def bake_here(args):
+    """Bake the files in this process, with the add-on registered (here, for
+    the run, unless it is already: an enabled extension)."""
+    package = importlib.import_module(__package__)
+    registered = hasattr(bpy.types.Material, "paint_lut")
+    if not registered:
+        package.register()
+    try:
+        return [bake_file(path, force=args.force, pack=args.pack) for path in progress(args.files, len(args.files))]
+    finally:
+        if not registered:
+            package.unregister()
+
+
+def child_command(script=None) -> list:
+    """How to start a child process that bakes one file: ``script`` (a file
+    that runs ``main``, e.g. scripts/batch_bake.py) or else this module's
+    ``main`` imported by name; run by Blender in the background when we run
+    inside Blender (bpy loaded by it), else by this Python."""
+    in_blender = pathlib.Path(bpy.app.binary_path).name.lower().startswith("blender")
+    if script is not None:
+        if in_blender:
+            return [bpy.app.binary_path, "-b", "--factory-startup", "-P", str(script), "--"]
+        return [sys.executable, str(script)]
+    top = sys.modules[__name__.partition(".")[0]]
+    root = [str(pathlib.Path(top.__file__).resolve().parents[1])] if getattr(top, "__file__", None) else []
+    code = f"import importlib, sys; sys.path[:0] = {root!r}; sys.exit(importlib.import_module({__name__!r}).main())"
+    if in_blender:  # an extension is enabled by the preferences: keep them unless we run without
+        factory = ["--factory-startup"] if "--factory-startup" in sys.argv else []
+        return [bpy.app.binary_path, "-b", *factory, "--python-expr", code, "--"]
+    return [sys.executable, "-c", code, "--"]
+
+
+def bake_parallel(args, script=None):
+    """One process per file, at most ``--jobs`` at a time (Blender's data is
+    one file per process); their reports go to a temporary directory that
+    is removed afterwards."""
+    with tempfile.TemporaryDirectory(prefix="batch_bake") as tmp:
+        return _bake_in_children(args, pathlib.Path(tmp), child_command(script))
+
+
+def _bake_in_children(args, tmp, prefix):
+    flags = [*(["--force"] if args.force else []), *(["--pack"] if args.pack else [])]
+
+    def one(i, path):
+        report = tmp / f"{i}.json"
+        command = [*prefix, str(path), "--report", str(report), *flags]
+        done = subprocess.run(command, capture_output=True, text=True)
+        if report.exists():
+            return json.loads(report.read_text())[0]
+        reason = (done.stderr.strip().splitlines() or ["no report"])[-1]
+        return {"file": str(pathlib.Path(path).resolve()), "status": "failed", "reason": reason, "materials": {}}
+
+    with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
+        futures = [pool.submit(one, i, path) for i, path in enumerate(args.files)]
+        return [f.result() for f in progress(futures, len(futures))]
+
+
+def main(argv=None, *, script=None) -> int:
+    """The batch command line (``argv``: default the arguments after '--'
+    inside Blender, else the command line's).  ``script``: the file the
+    parallel children run (default: this module's ``main``).  Prints the
+    summary, writes the JSON report (--report) and returns the exit status:
+    0, 1 if any file or material failed (or a linked material's library
+    holds no current bake), 2 on bad arguments or an unwritable report,
+    130 when interrupted."""
+    args = parse(script_argv() if argv is None else argv)
+    try:
+        if args.jobs > 1 and len(args.files) > 1:
+            entries = bake_parallel(args, script)
+        else:
+            entries = bake_here(args)
+    except KeyboardInterrupt:
+        print("interrupted: files already saved keep their bakes", file=sys.stderr)
+        return 130
+    print(summary(entries))
+    if args.report:
+        try:
+            lutfile.atomic_write_bytes(args.report, (json.dumps(entries, indent=2) + "\n").encode())
+        except OSError as exc:
+            print(f"error: cannot write the report {args.report}: {exc}", file=sys.stderr)
+            return 2
+    return 1 if failed(entries) else 0

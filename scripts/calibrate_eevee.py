@@ -117,15 +117,17 @@ def sum_shader(tree, terms):
 class SphereScene:
     """Spheres in a grid (``objects``), one material each (a list of
     [(closure, weight)] sums; None: no material, for the caller to assign),
-    an orthographic camera along +Z, a delta Sun, a black world."""
+    an orthographic camera along +Z, a delta Sun, a black world (built with
+    ``addon.scenes``' parts)."""
 
     def __init__(self, materials, cell=CELL, columns=None):
         import bpy
 
-        bpy.ops.wm.read_factory_settings(use_empty=True)
-        scene = bpy.context.scene
-        scene.render.engine = "BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else "BLENDER_EEVEE_NEXT"
-        scene.eevee.taa_render_samples = 1
+        from addon import scenes
+
+        columns = columns or math.ceil(math.sqrt(len(materials)))
+        rows = math.ceil(len(materials) / columns)
+        scene = scenes.new_scene(scenes.EEVEE, 1, (columns * cell, rows * cell))
         scene.eevee.use_shadows = False
         scene.eevee.use_raytracing = False
         scene.eevee.clamp_surface_direct = 0.0
@@ -133,12 +135,7 @@ class SphereScene:
         scene.render.threads_mode = "FIXED"
         scene.render.threads = 1
         scene.view_settings.view_transform = "Standard"
-        world = bpy.data.worlds.new("black")
-        scene.world = world
-        world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.0
-        columns = columns or math.ceil(math.sqrt(len(materials)))
-        rows = math.ceil(len(materials) / columns)
-        scene.render.resolution_x, scene.render.resolution_y = columns * cell, rows * cell
+        scenes.add_world(scene, 0.0, name="black")
         settings = scene.render.image_settings
         if hasattr(settings, "media_type"):  # Blender 5.0 on
             settings.media_type = "MULTI_LAYER_IMAGE"
@@ -150,9 +147,7 @@ class SphereScene:
         for i, terms in enumerate(materials):
             col, row = i % columns, i // columns
             x, y = (col - (columns - 1) / 2) * 2.2, ((rows - 1) / 2 - row) * 2.2
-            bpy.ops.mesh.primitive_uv_sphere_add(segments=128, ring_count=64, radius=1.0, location=(x, y, 0.0))
-            sphere = bpy.context.active_object
-            bpy.ops.object.shade_smooth()
+            sphere = scenes.add_uv_sphere(128, 64, radius=1.0, location=(x, y, 0.0))
             self.objects.append(sphere)
             self.cells.append((row, col))
             if terms is None:
@@ -164,19 +159,9 @@ class SphereScene:
             out = tree.nodes.new("ShaderNodeOutputMaterial")
             tree.links.new(sum_shader(tree, terms), out.inputs["Surface"])
             sphere.data.materials.append(mat)
-        cam = bpy.data.cameras.new("camera")
-        cam.type = "ORTHO"
-        cam.ortho_scale = 2.2 * max(columns, rows)
-        camera = bpy.data.objects.new("camera", cam)
-        camera.location = (0.0, 0.0, 10.0)
-        scene.collection.objects.link(camera)
-        scene.camera = camera
-        sun = bpy.data.lights.new("sun", "SUN")
-        sun.energy = 1.0
-        sun.angle = 0.0
-        sun.use_shadow = False
-        self.sun = bpy.data.objects.new("sun", sun)
-        scene.collection.objects.link(self.sun)
+        scenes.add_camera(scene, location=(0.0, 0.0, 10.0), ortho_scale=2.2 * max(columns, rows))
+        self.sun = scenes.add_sun(scene, energy=1.0, angle=0.0)
+        self.sun.data.use_shadow = False
         self.scene, self.cell, self.columns, self.rows = scene, cell, columns, rows
         self._path = os.path.join(tempfile.mkdtemp(prefix="eevee_calibration"), "render.exr")
 

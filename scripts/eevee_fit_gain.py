@@ -2,7 +2,7 @@
 ``lut.eevee.evaluate`` (EEVEE's measured closures) in place of
 ``Closure.evaluate`` (Cycles' formulas), rendered by EEVEE and measured
 against the model like ``scripts/render_fidelity.py`` (the plane oracle of
-tests/blender_oracle.py on its EEVEE grid, cos-weighted relative RMS).
+addon/scenes.py on its EEVEE grid, cos-weighted relative RMS).
 
     .venv/bin/python scripts/eevee_fit_gain.py [--paints satin matte]
 
@@ -19,12 +19,12 @@ import sys
 import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+sys.path.insert(0, str(ROOT))
 
 import bpy  # noqa: E402
-from blender_oracle import EEVEE, GRID_EEVEE, Oracle, paints, relative_rms  # noqa: E402
 
 from addon import nodes  # noqa: E402
+from addon.scenes import EEVEE, GRID_EEVEE, Oracle, paints, relative_rms  # noqa: E402
 from lut import eevee, fitting, render  # noqa: E402
 
 

@@ -5,7 +5,7 @@ colour, IOR n, roughness sqrt(slope), Blender's default multiscatter GGX).
 
     .venv/bin/python scripts/principled_fallback.py [--out FILE.json]
 
-The measure is the acceptance measure (tests/blender_oracle.py): the
+The measure is the acceptance measure (addon/scenes.py): the
 cos-weighted relative RMS of f·cos θl against Paint.brdf · cos θl for
 θl, θv <= 75° away from the mirror direction."""
 
@@ -17,11 +17,11 @@ import pathlib
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+sys.path.insert(0, str(ROOT))
 
 import bpy  # noqa: E402,F401
-from blender_oracle import Oracle, paints, principled, principled_params_material, relative_rms  # noqa: E402
 
+from addon.scenes import Oracle, paints, principled, principled_params_material, relative_rms  # noqa: E402
 from lut import principled as fallback  # noqa: E402
 
 fallback_material = principled_params_material

@@ -2,9 +2,10 @@
 
     .venv/bin/python scripts/render_cost.py [--samples N] [--size PX] [--engine CYCLES|EEVEE]
 
-Renders a UV sphere lit by a Sun and a dim world at 256x256, once with a
-Principled BSDF and once with each preset's baked node group, and prints the
-time ratio (best of 3 renders after a warm-up)."""
+Renders a UV sphere lit by a Sun and a dim world at 256x256
+(addon.scenes.sphere_scene), once with a Principled BSDF and once with each
+preset's baked node group, and prints the time ratio (best of 3 renders
+after a warm-up)."""
 
 from __future__ import annotations
 
@@ -20,34 +21,7 @@ import bpy  # noqa: E402
 
 import addon  # noqa: E402
 import lut  # noqa: E402
-from addon import api  # noqa: E402
-
-
-def scene(size, samples, engine="CYCLES"):
-    bpy.ops.wm.read_factory_settings(use_empty=True)
-    sc = bpy.context.scene
-    sc.render.engine = engine
-    sc.eevee.taa_render_samples = samples
-    sc.cycles.device = "CPU"
-    sc.cycles.samples = samples
-    sc.cycles.use_denoising = False
-    sc.render.resolution_x = sc.render.resolution_y = size
-    sc.render.filepath = str(pathlib.Path(tempfile.mkdtemp()) / "cost.png")
-    world = bpy.data.worlds.new("world")
-    sc.world = world
-    world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.3
-    bpy.ops.mesh.primitive_uv_sphere_add(segments=64, ring_count=32)
-    sphere = bpy.context.object
-    bpy.ops.object.shade_smooth()
-    cam = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
-    cam.location = (0, -4, 0)
-    cam.rotation_euler = (1.5708, 0, 0)
-    sc.collection.objects.link(cam)
-    sc.camera = cam
-    sun = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
-    sun.rotation_euler = (0.6, 0.3, 0.0)
-    sc.collection.objects.link(sun)
-    return sc, sphere
+from addon import api, scenes  # noqa: E402
 
 
 def timed(sc, repeat=3):
@@ -67,12 +41,8 @@ def main(argv=None):
     parser.add_argument("--size", type=int, default=256)
     args = parser.parse_args(argv)
     addon.register()
-    engine = (
-        "CYCLES"
-        if args.engine == "CYCLES"
-        else ("BLENDER_EEVEE" if bpy.app.version >= (5, 0, 0) else "BLENDER_EEVEE_NEXT")
-    )
-    sc, sphere = scene(args.size, args.samples, engine)
+    engine = "CYCLES" if args.engine == "CYCLES" else scenes.EEVEE
+    sc, sphere = scenes.sphere_scene(args.size, args.samples, engine)
     principled = bpy.data.materials.new("principled")
     sphere.data.materials.append(principled)
     base = timed(sc)

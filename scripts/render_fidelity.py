@@ -4,7 +4,7 @@ named paints and the randomised acceptance set (the README's fidelity table).
 
     .venv/bin/python scripts/render_fidelity.py [--random 24] [--eevee-random 6] [--out FILE.json]
 
-A plane lit by a Sun and seen by an orthographic camera (tests/blender_oracle.py)
+A plane lit by a Sun and seen by an orthographic camera (addon/scenes.py)
 renders f·E·cos θl; the measure is the cos-weighted relative RMS against
 Paint.brdf · cos θl for θl, θv <= 75° away from the mirror direction.
 Cycles is exact, so its figure is the closure fit's (printed beside it: the
@@ -22,13 +22,13 @@ import sys
 import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path[:0] = [str(ROOT), str(ROOT / "tests")]
+sys.path.insert(0, str(ROOT))
 
 import bpy  # noqa: E402,F401
 import numpy as np  # noqa: E402
-from blender_oracle import EEVEE, GRID, GRID_EEVEE, Oracle, paint_material, paints, principled, relative_rms  # noqa: E402
 
 import addon  # noqa: E402
+from addon.scenes import EEVEE, GRID, GRID_EEVEE, Oracle, paint_material, paints, principled, relative_rms  # noqa: E402
 from lut import bench, files  # noqa: E402
 
 

@@ -28,6 +28,11 @@ def _group_node(material, target="CYCLES"):
     return nodes.group_of(material, target)
 
 
+def _states(status):
+    """{material name: state} of ``api.bake_materials``' statuses."""
+    return {name: s.state for name, s in status.items()}
+
+
 def _inputs(material, target="CYCLES"):
     node = _group_node(material, target)
     return {s.name: (tuple(s.default_value)[:3] if s.type == "RGBA" else s.default_value) for s in node.inputs}
@@ -146,7 +151,7 @@ def test_every_colour_of_a_type_shares_one_bake_and_one_group(fresh_file, lut_di
     assert _inputs(a)["Pigment Color"] == pytest.approx((0.8, 0.1, 0.1))
     assert _inputs(b)["Pigment Color"] == pytest.approx((0.1, 0.1, 0.8))
     status = api.bake_materials({a, b}, directory=lut_dir, **SMALL)
-    assert status == {"car": "cached", "car Eevee": "cached"}
+    assert _states(status) == {"car": "cached", "car Eevee": "cached"}
     assert status["car"].key == status["car Eevee"].key
 
 
@@ -183,14 +188,14 @@ def test_glossy_black_bakes_and_renders_only_its_mirror(material, lut_dir):
     assert any(nd.type == "BSDF_METALLIC" and nd.label.startswith("Mirror") for nd in group.nodes)
 
 
-def test_bake_operator_runs_headless(material, lut_dir, monkeypatch):
-    from addon import api
-
-    monkeypatch.setattr(api, "lut_directory", lambda: lut_dir)  # the operator bakes where the file says
+def test_bake_operator_runs_headless(material, tmp_path):
+    """The operator bakes where the file says: next to the saved .blend."""
+    bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "scene.blend"))
     material.paint_lut.preset = "glossy_white"
     with bpy.context.temp_override(material=material):
         assert bpy.ops.paint_lut.bake("EXEC_DEFAULT") == {"FINISHED"}
     assert not material.paint_lut.stale and material.paint_lut.lut_path.endswith(".exr")
+    assert (tmp_path / material.paint_lut.lut_path.removeprefix("//")).is_file()
 
 
 def test_background_job_reports_progress_and_cancels_anywhere(tmp_path):
@@ -341,13 +346,16 @@ def test_bake_scene_reports_baked_cached_unused(fresh_file, lut_dir):
         mesh.materials.append(material)
         scene.collection.objects.link(bpy.data.objects.new(material.name, mesh))
     small = {"directory": lut_dir, **SMALL}
-    assert api.bake_scene(scene, **small) == {"a": "baked", "b": "baked", "unused": "unused"}
-    assert api.bake_scene(scene, **small) == {"a": "cached", "b": "cached", "unused": "unused"}
+    assert _states(api.bake_scene(scene, **small)) == {"a": "baked", "b": "baked", "unused": "unused"}
+    assert _states(api.bake_scene(scene, **small)) == {"a": "cached", "b": "cached", "unused": "unused"}
     materials[1].paint_lut.g = 0.4
     status = api.bake_scene(scene, **small)
-    assert status == {"a": "cached", "b": "baked", "unused": "unused"}
+    assert _states(status) == {"a": "cached", "b": "baked", "unused": "unused"}
     assert status["a"].key != status["b"].key and set(status["b"].errors) == {"CYCLES", "EEVEE"}
-    assert api.bake_scene(scene, force=True, **small)["a"] == "baked"
+    assert api.bake_scene(scene, force=True, **small)["a"].state == "baked"
+    materials[0].paint_lut["n"] = -2.0  # as a script or a newer version might store it
+    failed = api.bake_scene(scene, **small)["a"]
+    assert failed.state == "failed" and "n must be" in failed.reason and str(failed) == f"failed: {failed.reason}"
 
 
 def test_a_material_from_an_older_release_is_rebaked_not_trusted(material, lut_dir):
@@ -395,7 +403,7 @@ def test_save_as_elsewhere_rebakes_what_points_at_the_old_folder(fresh_file, tmp
     material = bpy.data.materials["paint"]
     paint = api.paint_of(material)
     assert not api.is_current(material, paint, **SMALL)
-    assert api.bake_materials({material}, **SMALL) == {"paint": "baked"}
+    assert _states(api.bake_materials({material}, **SMALL)) == {"paint": "baked"}
     assert api.is_current(material, paint, **SMALL)
     weights = nodes.group_weights_path(_group_node(material).node_tree)
     assert weights.parent == (tmp_path / "b" / "paint_lut").resolve()

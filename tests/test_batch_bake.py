@@ -1,4 +1,4 @@
-"""Headless batch baking (scripts/batch_bake.py over addon.batch): what is
+"""Headless batch baking (addon.batch.main; scripts/batch_bake.py runs it): what is
 used gets baked, the cache is honoured, broken inputs fail alone, and saving
 is atomic."""
 
@@ -55,6 +55,10 @@ def edit_blend(path, material, **fields):
 def run(*args, cwd=None):
     done = subprocess.run([sys.executable, str(SCRIPT), *map(str, args)], capture_output=True, text=True, cwd=cwd)
     return done
+
+
+def report_of(path):
+    return json.loads(pathlib.Path(path).read_text())
 
 
 def statuses(report_path, index=0):
@@ -150,6 +154,21 @@ def test_parallel_jobs_give_the_same_report(tmp_path):
     entries = json.loads(report.read_text())
     assert [e["file"] for e in entries] == [str(f.resolve()) for f in files]
     assert [{n: m["status"] for n, m in e["materials"].items()} for e in entries] == [{"m0": "baked"}, {"m1": "baked"}]
+
+
+def test_the_shipped_command_runs_without_the_script(tmp_path, capsys):
+    """addon.batch.main, as the extension ships it: in this process, and its
+    parallel children started by module name, not by scripts/batch_bake.py."""
+    files = [make_blend(tmp_path / f"{i}.blend", used=(f"m{i}",), unused=()) for i in range(2)]
+    report = tmp_path / "report.json"
+    assert batch.main([*map(str, files), "--jobs", "2", "--report", str(report)]) == 0
+    assert [{n: m["status"] for n, m in e["materials"].items()} for e in report_of(report)] == [
+        {"m0": "baked"},
+        {"m1": "baked"},
+    ]
+    assert batch.main([str(files[0]), "--report", str(report)]) == 0
+    assert report_of(report)[0]["materials"]["m0"]["status"] == "cached"
+    assert f"{files[0].resolve()}: unchanged (1 cached)" in capsys.readouterr().out
 
 
 def test_bad_arguments_name_the_parameter(tmp_path):

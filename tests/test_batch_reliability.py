@@ -334,10 +334,9 @@ def test_paints_within_the_limits_presets_and_spectral_paints_fit():
     validation.check_paint_fits(lut.Paint(rho=(1.0, 0.0, 0.0), space="Linear Rec.709"), "Linear Rec.2020")
 
 
-def test_the_limits_are_those_that_clamp_today(tmp_path, monkeypatch):
+def test_the_limits_are_those_that_clamp_today():
     """What the check refuses is exactly what set_paint would change."""
     new_file()
-    monkeypatch.setattr(api, "lut_directory", lambda: tmp_path)
     for paint in (lut.Paint(n=0.8), lut.Paint(n=5.0), lut.Paint(facet=2.0), lut.Paint(g=0.995)):
         material = bpy.data.materials.new("probe")
         addon.properties.set_fields(material.paint_lut, paint)  # what set_paint did before it checked

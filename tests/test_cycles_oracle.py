@@ -10,9 +10,8 @@ import pytest
 
 pytest.importorskip("bpy")
 
-from blender_oracle import Oracle, paint_material, paints, relative_rms  # noqa: E402
-
 import lut  # noqa: E402
+from addon.scenes import Oracle, paint_material, paints, relative_rms  # noqa: E402
 from lut import bench, closures, fitting, models  # noqa: E402
 
 pytestmark = pytest.mark.render

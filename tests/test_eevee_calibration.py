@@ -102,7 +102,7 @@ GEOMETRIES = [(0.35, 0.5, 0.2), (0.8, 0.3, 2.4), (1.05, 1.1, 0.5), (0.2, 1.2, 1.
 @pytest.fixture(scope="module")
 def oracle():
     pytest.importorskip("bpy")
-    from blender_oracle import EEVEE, Oracle
+    from addon.scenes import EEVEE, Oracle
 
     return Oracle(irradiance=1.0, engine=EEVEE)
 

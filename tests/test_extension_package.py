@@ -1,6 +1,7 @@
 """The extension zip (scripts/build_extension.py): built and validated by
 Blender's own builder, then installed into a clean Blender user directory
-with no network, where a preset is baked and rendered."""
+with no network, where a preset is baked and rendered by the shipped oracle
+and the shipped batch command finds the saved file's bake current."""
 
 import importlib.util
 import os
@@ -31,7 +32,16 @@ def test_zip_holds_the_add_on_manifest_and_lut_wheel(package):
         wheel = manifest["wheels"][0].removeprefix("./")
         # The one permission says what is written, where, and why.
         assert ".blend" in manifest["permissions"]["files"] and "reuse" in manifest["permissions"]["files"]
-        assert {"__init__.py", "api.py", "nodes.py", "properties.py", "library.py", wheel} <= names
+        assert {
+            "__init__.py",
+            "api.py",
+            "batch.py",
+            "nodes.py",
+            "properties.py",
+            "scenes.py",
+            "library.py",
+            wheel,
+        } <= names
         assert {"assets/paint_lut_library.blend", "assets/blender_assets.cats.txt"} <= names
         assert not any(name.startswith(("lut/", "tests/", "scripts/")) or "__pycache__" in name for name in names)
         with zipfile.ZipFile(archive.open(wheel)) as inner:
@@ -109,16 +119,16 @@ def test_manifest_and_versions_agree():
 
 INSTALLED = textwrap.dedent(
     """
-    import importlib, math, sys
+    import importlib, json, math, sys
     sys.path.insert(0, {foreign!r})  # another extension's top-level lut
-    sys.path.insert(0, {tests!r})
-    from blender_oracle import Oracle  # test harness only; not the add-on
-    oracle = Oracle()  # factory settings first: they would reset the preferences
     import bpy
+    bpy.ops.wm.read_factory_settings(use_empty=True)  # first: it resets the preferences
     result = bpy.ops.extensions.package_install_files(
         filepath={zip!r}, repo="user_default", enable_on_install=True
     )
     assert result == {{"FINISHED"}}, result
+    scenes = importlib.import_module("bl_ext.user_default.paint_lut.scenes")
+    oracle = scenes.Oracle(reset=False)  # the shipped oracle, in the empty file
     import lut as foreign
     assert foreign.FOREIGN, "the foreign lut is first on sys.path"
     import paint_lut_core as lut
@@ -142,6 +152,10 @@ INSTALLED = textwrap.dedent(
     print("LUT_PATH", material.paint_lut.lut_path)
     print("RENDERED", *rendered)
     print("MODEL", *model)
+    bpy.ops.wm.save_mainfile()
+    batch = importlib.import_module("bl_ext.user_default.paint_lut.batch")  # the shipped farm command
+    code = batch.main([{blend!r}, "--report", {report!r}])
+    print("BATCH", code, json.load(open({report!r}))[0]["materials"]["paint"]["status"])
     """
 )
 
@@ -152,7 +166,7 @@ def test_installs_offline_into_a_clean_user_directory_and_renders(package, tmp_p
     (foreign / "lut").mkdir(parents=True)
     (foreign / "lut" / "__init__.py").write_text("FOREIGN = True\n")
     code = INSTALLED.format(
-        tests=str(ROOT / "tests"), foreign=str(foreign), zip=str(package), blend=str(tmp_path / "scene.blend")
+        foreign=str(foreign), zip=str(package), blend=str(tmp_path / "scene.blend"), report=str(tmp_path / "bake.json")
     )
     env = {k: v for k, v in os.environ.items() if k not in {"PYTHONPATH", "BLENDER_USER_SCRIPTS"}}
     env.update(
@@ -179,6 +193,7 @@ def test_installs_offline_into_a_clean_user_directory_and_renders(package, tmp_p
     assert pathlib.Path(out["ADDON_FROM"]).is_relative_to(resources / "extensions" / "user_default" / "paint_lut")
     assert out["LUT_PATH"].startswith("//paint_lut/")
     assert (tmp_path / out["LUT_PATH"][2:]).exists()
+    assert out["BATCH"] == "0 cached"  # the file's material, baked above, found current
     rendered = [float(v) for v in out["RENDERED"].split()]
     model = [float(v) for v in out["MODEL"].split()]
     for r, m in zip(rendered, model, strict=True):

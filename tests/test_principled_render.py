@@ -1,4 +1,4 @@
-"""The Principled fallback against Cycles (tests/blender_oracle.py): the
+"""The Principled fallback against Cycles (addon/scenes.py): the
 model of lut.principled is Cycles' Principled BSDF, and the fitted fallback
 of a material, as rendered, has the error the fit reports and beats the
 Principled an artist would set up; the fallback leaves what Cycles and
@@ -12,10 +12,9 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-from blender_oracle import EEVEE, Oracle, principled_params_material, relative_rms  # noqa: E402
-from blender_oracle import principled as artists_principled  # noqa: E402
-
 import lut  # noqa: E402
+from addon.scenes import EEVEE, Oracle, principled_params_material, relative_rms  # noqa: E402
+from addon.scenes import principled as artists_principled  # noqa: E402
 from lut import principled  # noqa: E402
 
 pytestmark = pytest.mark.render

@@ -296,10 +296,10 @@ def test_the_readme_headless_snippet_gives_the_status_its_comment_promises(tmp_p
 
     readme = (ROOT / "README.md").read_text()
     snippet = next(block for block in re.findall(r"```python\n(.*?)```", readme, re.S) if "api.bake_scene" in block)
-    promised = re.search(r'api\.bake_scene\(.*\)\s*#\s*\{"red paint": "(\w+)"', snippet)
+    promised = re.search(r'api\.bake_scene\(.*\)\s*#\s*\{"red paint": BakeStatus\(state="(\w+)"', snippet)
     assert promised, snippet
     done = subprocess.run(
-        [sys.executable, "-c", snippet + "\nprint(status)\n"],
+        [sys.executable, "-c", snippet + "\nprint({name: s.state for name, s in status.items()})\n"],
         capture_output=True,
         text=True,
         cwd=tmp_path,

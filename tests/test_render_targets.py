@@ -7,7 +7,7 @@ import pytest
 
 bpy = pytest.importorskip("bpy")
 
-from blender_oracle import EEVEE, Oracle, paint_material, paints, relative_rms  # noqa: E402
+from addon.scenes import EEVEE, Oracle, paint_material, paints, relative_rms  # noqa: E402
 
 pytestmark = pytest.mark.render
 
