@@ -65,6 +65,18 @@ class BakeStatus:
     def __str__(self):
         return f"{self.state}: {self.reason}" if self.reason else self.state
 
+    def __eq__(self, other):
+        # Earlier releases returned the state as a string: scripts comparing
+        # ``status == "baked"`` keep working (the state alone, not the reason).
+        if isinstance(other, str):
+            return self.state == other
+        if not isinstance(other, BakeStatus):
+            return NotImplemented
+        return dataclasses.astuple(self) == dataclasses.astuple(other)
+
+    def __hash__(self):
+        return hash((self.state, self.reason, self.key))
+
 
 def engine_targets():
     """The render targets of this Blender: Cycles and EEVEE."""

@@ -38,7 +38,7 @@ import tempfile
 import bpy
 
 from . import api, nodes
-from ._lut import closures, fitting, lut, lutfile
+from ._lut import closures, files, fitting, lut
 
 #: The first bytes of a .blend file: plain, gzip (Blender < 3) or zstd compressed.
 _MAGIC = (b"BLENDER", b"\x1f\x8b", b"\x28\xb5\x2f\xfd")
@@ -60,7 +60,7 @@ def save_atomically(path: pathlib.Path, pack=False) -> None:
         for image in bpy.data.images:
             if image.source == "FILE" and image.packed_file is None and image.filepath:
                 image.pack()
-    with lutfile.atomic_target(path) as tmp:
+    with files.atomic_target(path) as tmp:
         os.remove(tmp)  # let Blender create it: no .blend1 of the placeholder
         _write_blend(tmp)
 
@@ -356,7 +356,7 @@ def main(argv=None, *, script=None) -> int:
     print(summary(entries))
     if args.report:
         try:
-            lutfile.atomic_write_bytes(args.report, (json.dumps(entries, indent=2) + "\n").encode())
+            files.atomic_write_bytes(args.report, (json.dumps(entries, indent=2) + "\n").encode())
         except OSError as exc:
             print(f"error: cannot write the report {args.report}: {exc}", file=sys.stderr)
             return 2

@@ -35,7 +35,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from lut import bench, fitting, lutfile  # noqa: E402
+from lut import bench, files, fitting  # noqa: E402
 
 #: Light-view angles of the sweep (degrees).
 GAMMAS = tuple(range(0, 176, 10))
@@ -142,7 +142,7 @@ def main(argv=None) -> int:
                 f"{key:16s} {name:6s} n={count:2d} worst {worst:.2%} median {median:.2%};"
                 f" {met} within {targets[name]:.0%}"
             )
-    lutfile.atomic_write_bytes(args.out, (json.dumps(report, indent=2) + "\n").encode())
+    files.atomic_write_text(args.out, json.dumps(report, indent=2) + "\n")
     print(f"Blender {version}: {len(rows)} paints in {time.time() - start:.0f} s; wrote {args.out}")
     return 0
 

@@ -356,6 +356,8 @@ def test_bake_scene_reports_baked_cached_unused(fresh_file, lut_dir):
     materials[0].paint_lut["n"] = -2.0  # as a script or a newer version might store it
     failed = api.bake_scene(scene, **small)["a"]
     assert failed.state == "failed" and "n must be" in failed.reason and str(failed) == f"failed: {failed.reason}"
+    # Scripts of earlier releases compared the status with its state's name.
+    assert failed == "failed" and failed != "baked" and status["a"] == "cached"
 
 
 def test_a_material_from_an_older_release_is_rebaked_not_trusted(material, lut_dir):
