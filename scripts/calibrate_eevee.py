@@ -165,10 +165,11 @@ class SphereScene:
         self.scene, self.cell, self.columns, self.rows = scene, cell, columns, rows
         self._path = os.path.join(tempfile.mkdtemp(prefix="eevee_calibration"), "render.exr")
 
-    def render(self, gamma):
+    def render(self, gamma, erode=0):
         """Per sphere: (θl, θv, φ, radiance (N, 3)) of its lit pixels, for the
         light at angle ``gamma`` from the view (in the XZ plane) and unit
-        irradiance."""
+        irradiance; ``erode``: leave out pixels within that many of the
+        sphere's silhouette (EEVEE shades them unlike the surface inside)."""
         import bpy
         import OpenImageIO as oiio
 
@@ -187,10 +188,16 @@ class SphereScene:
         out = []
         for row, col in self.cells:
             sl = np.s_[row * self.cell : (row + 1) * self.cell, col * self.cell : (col + 1) * self.cell]
-            n, c = normal[sl].reshape(-1, 3), rgb[sl].reshape(-1, 3)
-            length = np.linalg.norm(n, axis=1)
+            length = np.linalg.norm(normal[sl], axis=-1)
             ok = np.abs(length - 1.0) < 1e-3
-            n, c = n[ok] / length[ok, None], c[ok]
+            for _ in range(erode):
+                inner = ok.copy()
+                inner[1:] &= ok[:-1]
+                inner[:-1] &= ok[1:]
+                inner[:, 1:] &= ok[:, :-1]
+                inner[:, :-1] &= ok[:, 1:]
+                ok = inner
+            n, c = normal[sl][ok] / length[ok][:, None], rgb[sl][ok]
             theta_l, theta_v, phi = geometry(n, light)
             out.append((theta_l, theta_v, phi, c))
         return out

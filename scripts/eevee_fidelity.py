@@ -68,6 +68,7 @@ def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None)
         scene.scene.cycles.device = "CPU"
         scene.scene.cycles.samples = 1  # exact: a delta Sun, every closure evaluated per light sample
         scene.scene.cycles.use_denoising = False
+        scene.scene.cycles.max_bounces = 0  # direct light only: no sphere mirrors its neighbours
         cycles_samples = _sweep(scene, gammas)
         scene.scene.render.engine = engine
     for i, row in enumerate(rows):
@@ -75,7 +76,7 @@ def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None)
         model = row["paint"].brdf(tl, tv, ph) * np.cos(tl)[:, None]
         row["eevee"], row["bins"] = bench.binned_error(tl, tv, ph, rgb, model)
         if raw is not None:
-            raw[row["label"]] = (tl, tv, ph, rgb, model)
+            raw[row["label"]] = (tl, tv, ph, rgb, model, None if cycles_samples is None else cycles_samples[i][3])
         if cycles_samples is not None:
             crgb = cycles_samples[i][3]
             row["cycles"] = bench.binned_error(tl, tv, ph, crgb, model)[0]
@@ -83,11 +84,16 @@ def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None)
     return rows
 
 
+#: Pixels next to a sphere's silhouette left out: EEVEE shades them several
+#: times brighter than the surface inside (Cycles does not).
+ERODE = 2
+
+
 def _sweep(scene, gammas):
     """Per sphere: the concatenated (θl, θv, φ, radiance) of the sweep."""
     per = [[] for _ in scene.objects]
     for gamma in gammas:
-        for i, s in enumerate(scene.render(math.radians(gamma))):
+        for i, s in enumerate(scene.render(math.radians(gamma), erode=ERODE)):
             per[i].append(s)
     return [tuple(np.concatenate([x[j] for x in s]) for j in range(4)) for s in per]
 
