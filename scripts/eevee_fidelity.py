@@ -47,7 +47,7 @@ CELL = 48
 def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None):
     """Per (label, lut.Paint) of ``paints`` (materials baked in
     ``directory``): {"label", "paint", "eevee" (rendered error), "eevee_fit"
-    (the error the fit reports), "bins"}, and with ``cycles`` "cycles" (the
+    and "cycles_fit" (the errors the fits report), "bins"}, and with ``cycles`` "cycles" (the
     same spheres in Cycles against the model) and "eevee_vs_cycles" (EEVEE's
     pixels against Cycles'); ``raw``: a dict to receive each paint's samples.
     The add-on must be registered."""
@@ -59,7 +59,15 @@ def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None)
     for sphere, (label, paint) in zip(scene.objects, paints, strict=True):
         material = api.new_material(label, paint, directory=directory)
         sphere.data.materials.append(material)
-        rows.append({"label": label, "paint": paint, "eevee_fit": api.fit_errors(material).get("EEVEE", (None,))[0]})
+        reported = api.fit_errors(material)
+        rows.append(
+            {
+                "label": label,
+                "paint": paint,
+                "eevee_fit": reported.get("EEVEE", (None,))[0],
+                "cycles_fit": reported.get("CYCLES", (None,))[0],
+            }
+        )
     samples = _sweep(scene, gammas)
     cycles_samples = None
     if cycles:
@@ -131,16 +139,16 @@ def main(argv=None) -> int:
     for row in rows:
         report["paints"][row["label"]] = {
             "rough": row["paint"].slope > 0,
-            **{k: row.get(k) for k in ("eevee", "eevee_fit", "bins", "cycles", "eevee_vs_cycles")},
+            **{k: row.get(k) for k in ("eevee", "eevee_fit", "bins", "cycles", "cycles_fit", "eevee_vs_cycles")},
         }
         shown = "" if row["eevee_fit"] is None else f"{row['eevee_fit']:6.2%}"
         extra = ""
         if "cycles" in row:
             extra = f"  Cycles {row['cycles']:6.2%}  EEVEE vs Cycles {row['eevee_vs_cycles']:6.2%}"
         print(f"{row['label']:28s} EEVEE {row['eevee']:6.2%}  fit reports {shown}  ({row['bins']} bins){extra}")
-    targets = fitting.TARGET_ERROR["EEVEE"]
     report["summary"] = {}
     for key in ("eevee", "cycles", "eevee_vs_cycles"):
+        targets = fitting.TARGET_ERROR["CYCLES" if key == "cycles" else "EEVEE"]
         for name, (worst, median, count) in summary(rows, key).items():
             report["summary"][f"{key} {name}"] = {"worst": worst, "median": median, "count": count}
             met = sum(1 for r in rows if (r["paint"].slope > 0) == (name == "rough") and r[key] <= targets[name])

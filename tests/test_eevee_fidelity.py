@@ -40,3 +40,43 @@ def test_binned_error_leaves_out_the_mirror_and_what_the_measure_does_not_cover(
     assert bench.mirror_distance(0.0, 0.2, 1.0) == pytest.approx(0.2)
     with pytest.raises(ValueError, match="no bin"):
         bench.binned_error(tl[:2], tv[:2], ph[:2], model[:2], model[:2])
+
+
+@pytest.fixture(scope="module")
+def randomised(addon_registered, tmp_path_factory):
+    """The first 12 paints of the randomised set (3 smooth, 9 rough, dark and
+    light, both slope distributions, both signs of g) on spheres, rendered by
+    EEVEE and Cycles over the sweep of light angles."""
+    pytest.importorskip("bpy")
+    from scripts import eevee_fidelity
+
+    paints = bench.random_paints(12)
+    return eevee_fidelity.measure(paints, tmp_path_factory.mktemp("luts"), cycles=True)
+
+
+@pytest.mark.render
+def test_cycles_renders_every_paint_within_its_target_on_the_dense_measure(randomised):
+    """Every pixel of the spheres, not the 180 points of the acceptance grid:
+    within the Cycles target, or, where the fit reports a miss (the Gaussian
+    slope 2.88: rougher than any Blender lobe), near what it reports."""
+    from lut import fitting
+
+    for row in randomised:
+        target = fitting.TARGET_ERROR["CYCLES"]["rough" if row["paint"].slope > 0 else "smooth"]
+        assert row["cycles"] <= max(target, 1.5 * row["cycles_fit"]), row["label"]
+
+
+@pytest.mark.render
+def test_eevee_renders_the_randomised_set_as_measured(randomised):
+    """EEVEE (one sample, its own closure approximations, at most two exact
+    reflection lobes; the viewport's Material Preview and a final EEVEE
+    render are the same engine) against the model: bounds a little above
+    what this set measures on Blender 5.0 and 5.2 (README), so a broken
+    calibration or fit shows.  Smooth paints: the median within 4%; rough:
+    the median within 15%; none beyond 45%."""
+    smooth = [r["eevee"] for r in randomised if r["paint"].slope == 0]
+    rough = [r["eevee"] for r in randomised if r["paint"].slope > 0]
+    assert len(smooth) >= 3 and len(rough) >= 9
+    assert np.median(smooth) <= 0.04
+    assert np.median(rough) <= 0.15
+    assert max(smooth + rough) <= 0.45
