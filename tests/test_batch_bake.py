@@ -19,11 +19,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 SCRIPT = ROOT / "scripts" / "batch_bake.py"
 
 
-@pytest.fixture(scope="module", autouse=True)
-def registered():
-    addon.register()
-    yield
-    addon.unregister()
+pytestmark = pytest.mark.usefixtures("addon_registered")
 
 
 def make_blend(path, used=("red", "blue"), unused=("spare",)):
