@@ -54,7 +54,10 @@ class BakeStatus:
     the material's colours}), ``misses`` ({engine: (error, target)} where the
     fit misses its target) and ``key`` (the paint type's LUT key: materials
     with the same key shared one bake).  ``str()`` gives the line to show
-    ("failed: <reason>"); read the fields, never that text."""
+    ("failed: <reason>"); read the fields, never that text.  For scripts of
+    earlier releases, which got the text itself, a status compares equal to
+    its state's name (``status == "baked"``, ``status in {"baked",
+    "cached"}``); string methods and ``json.dumps`` need ``str(status)``."""
 
     state: str
     reason: str = ""
@@ -75,7 +78,7 @@ class BakeStatus:
         return dataclasses.astuple(self) == dataclasses.astuple(other)
 
     def __hash__(self):
-        return hash((self.state, self.reason, self.key))
+        return hash(self.state)  # equal objects (a status and its state's name) hash alike
 
 
 def engine_targets():

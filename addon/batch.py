@@ -304,7 +304,10 @@ def child_command(script=None) -> list:
         return [sys.executable, str(script)]
     top = sys.modules[__name__.partition(".")[0]]
     root = [str(pathlib.Path(top.__file__).resolve().parents[1])] if getattr(top, "__file__", None) else []
-    code = f"import importlib, sys; sys.path[:0] = {root!r}; sys.exit(importlib.import_module({__name__!r}).main())"
+    # bpy first: an installed extension's package (bl_ext...) exists once Blender has set up its repositories.
+    code = (
+        f"import bpy, importlib, sys; sys.path[:0] = {root!r}; sys.exit(importlib.import_module({__name__!r}).main())"
+    )
     if in_blender:  # an extension is enabled by the preferences: keep them unless we run without
         factory = ["--factory-startup"] if "--factory-startup" in sys.argv else []
         return [bpy.app.binary_path, "-b", *factory, "--python-expr", code, "--"]

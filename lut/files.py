@@ -1,8 +1,9 @@
 """Writing files atomically: to a temporary file in the same folder, renamed
 onto the target when complete (``os.replace``) and removed when the write
 fails, so an interrupted write never leaves a partial file and never loses
-the old one.  Every writer of lut, the add-on and the scripts goes through
-``atomic_target`` (or ``atomic_write_bytes`` / ``atomic_write_text``).
+the old one.  The writers of lut, the add-on and the scripts go through
+``atomic_target`` (or ``atomic_write_bytes`` / ``atomic_write_text``),
+except where Blender writes the file itself (a .blend library, a render).
 
 The temporary file is hidden and named ``.<stem>.<pid>@<host>.<random>.partial<suffix>``:
 a later write in the folder removes it if its writer was killed

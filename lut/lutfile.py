@@ -34,7 +34,7 @@ import numpy as np
 
 from . import exr
 
-# Re-exported: addon/batch.py and scripts/batch_bake.py write through lutfile.
+# Re-exported for callers of earlier releases, which wrote through lutfile.
 from .files import atomic_target, atomic_write_bytes  # noqa: F401
 
 FORMAT_VERSION = 2

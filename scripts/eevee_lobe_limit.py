@@ -3,7 +3,7 @@ the best Lambert + two-lobe combination EEVEE sums exactly, with each
 view's own pair of roughnesses (which no node group offers: the fit's pair
 is one for all views), from EEVEE's measured responses (``lut.eevee``).
 
-    .venv/bin/python scripts/eevee_lobe_limit.py [--paints 13 17 23] [--version 5.0]
+    .venv/bin/python scripts/eevee_lobe_limit.py [--paints 2 13 17 21 23] [--version 5.0]
 
 For each paint of ``lut.bench.random_paints`` named by its index, it bakes
 the type's LUT and prints the facet component's relative RMS on the fit's

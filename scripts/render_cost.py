@@ -4,8 +4,9 @@
 
 Renders a UV sphere lit by a Sun and a dim world at 256x256
 (addon.scenes.sphere_scene), once with a Principled BSDF and once with each
-preset's baked node group, and prints the time ratio (best of 3 renders
-after a warm-up)."""
+preset's baked node group (and of the randomised set's paints given by
+``--random``), and prints the time ratio (best of 3 renders after a
+warm-up)."""
 
 from __future__ import annotations
 
@@ -22,6 +23,7 @@ import bpy  # noqa: E402
 import addon  # noqa: E402
 import lut  # noqa: E402
 from addon import api, scenes  # noqa: E402
+from lut import bench, render  # noqa: E402
 
 
 def timed(sc, repeat=3):
@@ -39,6 +41,9 @@ def main(argv=None):
     parser.add_argument("--samples", type=int, default=16)
     parser.add_argument("--engine", choices=("CYCLES", "EEVEE"), default="CYCLES")
     parser.add_argument("--size", type=int, default=256)
+    parser.add_argument(
+        "--random", type=int, nargs="*", default=[], help="also these paints of lut.bench.random_paints, by index"
+    )
     args = parser.parse_args(argv)
     addon.register()
     engine = "CYCLES" if args.engine == "CYCLES" else scenes.EEVEE
@@ -47,11 +52,17 @@ def main(argv=None):
     sphere.data.materials.append(principled)
     base = timed(sc)
     print(f"Principled BSDF: {base:.3f} s ({args.engine}, {args.size}x{args.size}, {args.samples} samples)")
-    for name in lut.PRESETS:
-        material = api.new_material(name, lut.preset(name), directory=pathlib.Path(tempfile.mkdtemp()))
+    paints = [(name, lut.preset(name)) for name in lut.PRESETS]
+    randomised = bench.random_paints()
+    paints += [randomised[i] for i in args.random]
+    for name, paint in paints:
+        directory = pathlib.Path(tempfile.mkdtemp())
+        material = api.new_material(name, paint, directory=directory)
         sphere.data.materials[0] = material
         t = timed(sc)
-        print(f"{name:13} {t:.3f} s  ratio {t / base:.2f}")
+        cached = render.bake_for_render(paint, directory, eevee_calibration=api.eevee_calibration())
+        closures = sum(c.cost for c in cached.fits[args.engine].closures)
+        print(f"{name:28} {t:.3f} s  ratio {t / base:.2f}  ({closures} closures)")
 
 
 if __name__ == "__main__":

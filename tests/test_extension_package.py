@@ -63,13 +63,16 @@ def test_wheel_leaves_out_development_modules_and_still_imports(tmp_path):
     with zipfile.ZipFile(wheel) as inner:
         files = set(inner.namelist())
         inner.extractall(tmp_path / "site")
-    for module in ("figures.py", "bench.py", "examples.py"):
+    for module in build_extension.DEV_ONLY:
         assert f"{package}/{module}" not in files
     code = textwrap.dedent(
         f"""
         import importlib, sys
         sys.modules["matplotlib"] = None  # no matplotlib either
-        for name in ("", ".__main__", ".principled", ".render", ".fitting", ".lutfile", ".exr"):
+        for name in (
+            "", ".__main__", ".principled", ".render", ".fitting", ".lutfile", ".exr",
+            ".schema", ".files", ".presets", ".gloss", ".eevee",
+        ):
             importlib.import_module("{package}" + name)
         from {package} import __main__ as cli
         try:

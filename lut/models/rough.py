@@ -5,9 +5,6 @@ facet normals per direction pair, one normal drawn for the incident ray and one
 for the scattered ray from the slope distribution as seen by that ray
 (Eq. 36).  Here the same average is computed by deterministic quadrature:
 
-The paper's random-pairs average itself is kept, as a check only, in
-``reference.rough_single_random``.
-
 * **Visible-normal rule.**  For a direction u (towards the source or the
   viewer) the facets it meets have density P(ζ) max(cos ι, 0) sec θn per
   dζx dζy (Eq. 36), normalized exactly (each ray meets one facet; the paper's
@@ -45,6 +42,9 @@ The paper's random-pairs average itself is kept, as a check only, in
 
 Neither term includes shadowing, or rays that cross the interface more than
 once, as in the paper.
+
+The paper's random-pairs average itself is kept, as a check only, in
+``reference.rough_single_random``.
 """
 
 from __future__ import annotations
