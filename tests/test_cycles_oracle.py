@@ -148,7 +148,7 @@ def test_randomised_paints_render_as_their_fits_promise(registered_oracle, tmp_p
     misses = [(label, r, p, TARGETS["rough" if rough else "smooth"]) for label, rough, r, p in rows]
     misses = [m for m in misses if m[1] > m[3]]
     assert all(p > 0.9 * target for _, _, p, target in misses), misses  # every miss is reported by its fit
-    assert len(misses) <= 3, misses
+    assert len(misses) <= 1, misses
 
 
 def test_a_textured_pigment_renders_every_patch_as_its_paint(registered_oracle, tmp_path):
