@@ -21,8 +21,10 @@ The fit, per render target (``fit_lut``):
    none of those helps: near-collinear Toon ramps mislead the
    unconstrained ranking), until the render
    cost budget (closures per material) is spent or the error is far below
-   target; a few closures more (``EXTRA_BUDGET``) while a component's
-   error is still above the target.  Grey closures (no colour input) serve the facet component only
+   target.  Where a component's error on the acceptance grid (step 4) is
+   then still above the target (some colour of the type would miss it),
+   the selection goes on for a few closures more (``EXTRA_BUDGET``), kept
+   if they lower that error.  Grey closures (no colour input) serve the facet component only
    and keep weights <= 1 (a Mix Shader factor clamps there).
 3. Weights.  Non-negative least squares per view and component over the
    chosen closures (``lut.nnls``).
@@ -71,9 +73,9 @@ TARGET_ERROR = {"CYCLES": {"smooth": 0.02, "rough": 0.05}, "EEVEE": {"smooth": 0
 #: Closures per material (render cost grows with their number; the mirror
 #: of a smooth type comes on top).  EEVEE evaluates few closures per pixel.
 BUDGET = {"CYCLES": 8, "EEVEE": 3}
-#: Closures a fit may add beyond ``BUDGET`` while a component's error is
-#: still above the target: only the types that need them (very rough facets,
-#: strongly back-scattering pigments) pay the render cost.
+#: Closures a fit may add beyond ``BUDGET`` where a component's acceptance
+#: error is above the target within it: only the types that need them (very
+#: rough facets, strongly back-scattering pigments) pay the render cost.
 EXTRA_BUDGET = {"CYCLES": 4, "EEVEE": 0}
 
 #: Views (columns of the weights texture) and the light grid of each view.
@@ -269,14 +271,12 @@ def _nnls_fit(gram, rhs, norm, idx, upper):
     return x, float(_relative(np.maximum(err, 0.0), norm))
 
 
-def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None, extra=(0, np.inf)):
+def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None):
     """Forward selection of closures for every (tile, component) target.
     gram (M, K, K); rhs (M, P, K), norm (M, P, 2) over P targets; allowed
     (P, K); upper (K,); caps: (mask over K, most closures of the mask);
-    goal: the relative squared error below which selection stops; extra:
-    (closures, relative squared error) — up to that many closures beyond
-    ``budget`` while some target's error is above that.  Returns the chosen
-    closure indices in order."""
+    goal: the relative squared error below which selection stops.  Returns
+    the chosen closure indices in order."""
     targets = [p for p in range(rhs.shape[1]) if norm[:, p, 0].sum() > 0]
     chosen: list[int] = []
     errors = {p: 1.0 for p in targets}
@@ -284,8 +284,7 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None, extr
     while targets:
         if max(errors.values()) < goal:
             break
-        limit = budget + extra[0] if max(errors.values()) > extra[1] else budget
-        if spent >= limit:
+        if spent >= budget:
             break
         capped = caps is not None and sum(caps[0][k] for k in chosen) >= caps[1]
         cands = [
@@ -293,7 +292,7 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None, extr
             for k in range(gram.shape[1])
             if k not in chosen
             and allowed[targets, k].any()
-            and spent + cost[k] <= limit
+            and spent + cost[k] <= budget
             and not (capped and caps[0][k])
         ]
         if not cands:
@@ -427,22 +426,41 @@ def fit_lut(
         # EEVEE sums one diffuse normal and two reflection closures exactly
         # per pixel; beyond that it picks closures at random (noise).
         caps = (np.array([eevee.is_reflection(c) for c in basis]), eevee.EXACT_REFLECTION_CLOSURES)
-    chosen = _select(gram, rhs, norm, allowed, upper, cost, budget, goal**2, caps, (extra_budget, target_error**2))
-    weights = np.zeros((len(chosen), c_, m_, t_))
-    for p in range(t_ * c_):
-        idx = [i for i, k in enumerate(chosen) if allowed[p, k]]
-        if not idx or norm[:, p, 0].sum() == 0:
-            continue
-        cols = [chosen[i] for i in idx]
-        x, _ = _nnls_fit(gram, rhs[:, p], norm[:, p], cols, upper[cols])
-        weights[idx, p % c_, :, p // c_] = x.T
-    if t_ > 1:  # a grey closure has one weight for every channel: the tiles' mean
-        g = [i for i, k in enumerate(chosen) if grey[k]]
-        weights[g] = weights[g].mean(axis=-1, keepdims=True)
-    keep = [i for i in range(len(chosen)) if weights[i].max() > 0]
-    basis_kept = [basis[chosen[i]] for i in keep]
-    weights = weights[keep]
-    residual, reference = _acceptance_grams(lut, basis_kept, cos_view, weights, evaluate)
+
+    def weights_of(chosen):
+        """NNLS weights of the chosen closures, the kept closures and their
+        acceptance Gram matrices."""
+        weights = np.zeros((len(chosen), c_, m_, t_))
+        for p in range(t_ * c_):
+            idx = [i for i, k in enumerate(chosen) if allowed[p, k]]
+            if not idx or norm[:, p, 0].sum() == 0:
+                continue
+            cols = [chosen[i] for i in idx]
+            x, _ = _nnls_fit(gram, rhs[:, p], norm[:, p], cols, upper[cols])
+            weights[idx, p % c_, :, p // c_] = x.T
+        if t_ > 1:  # a grey closure has one weight for every channel: the tiles' mean
+            g = [i for i, k in enumerate(chosen) if grey[k]]
+            weights[g] = weights[g].mean(axis=-1, keepdims=True)
+        keep = [i for i in range(len(chosen)) if weights[i].max() > 0]
+        kept = [basis[chosen[i]] for i in keep]
+        return (kept, weights[keep], *_acceptance_grams(lut, kept, cos_view, weights[keep], evaluate))
+
+    def worst_component(grams):
+        """The largest relative error of one component (the error of the
+        type's worst colour, where that component dominates)."""
+        residual, reference = grams
+        ref = reference.sum(axis=0).diagonal()
+        return float(np.max(np.sqrt(residual.sum(axis=0).diagonal()[ref > 0] / ref[ref > 0]), initial=0.0))
+
+    chosen = _select(gram, rhs, norm, allowed, upper, cost, budget, goal**2, caps)
+    basis_kept, weights, residual, reference = weights_of(chosen)
+    if extra_budget > 0 and worst_component((residual, reference)) > target_error:
+        # Some colour of this type misses the target: spend the extra closures
+        # (the selection is deterministic, so it continues the same choice)
+        # where they lower the worst component's error.
+        more = weights_of(_select(gram, rhs, norm, allowed, upper, cost, budget + extra_budget, goal**2, caps))
+        if worst_component(more[2:]) < worst_component((residual, reference)):
+            basis_kept, weights, residual, reference = more
     n = reference_index(type_dict["n"])
     return Fit(
         target=target,
