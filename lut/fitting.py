@@ -23,9 +23,10 @@ The fit, per render target (``fit_lut``):
    cost budget (closures per material) is spent or the error is far below
    target.  Where a component's error on the acceptance grid (step 4) is
    then still above the target (some colour of the type would miss it),
-   the selection goes on for a few closures more (``EXTRA_BUDGET``), kept
-   if they lower that error.  Grey closures (no colour input) serve the facet component only
-   and keep weights <= 1 (a Mix Shader factor clamps there).
+   the selection is made again with a few closures more (``EXTRA_BUDGET``)
+   and kept if it lowers that error.  Grey closures (no colour input)
+   serve the facet component only and keep weights <= 1 (a Mix Shader
+   factor clamps there).
 3. Weights.  Non-negative least squares per view and component over the
    chosen closures (``lut.nnls``).
 4. Error.  On the acceptance grid (θl, θv <= 75°, azimuths off the mirror):
@@ -455,9 +456,9 @@ def fit_lut(
     chosen = _select(gram, rhs, norm, allowed, upper, cost, budget, goal**2, caps)
     basis_kept, weights, residual, reference = weights_of(chosen)
     if extra_budget > 0 and worst_component((residual, reference)) > target_error:
-        # Some colour of this type misses the target: spend the extra closures
-        # (the selection is deterministic, so it continues the same choice)
-        # where they lower the worst component's error.
+        # Some colour of this type misses the target: select again with the
+        # extra closures, and keep that choice if it lowers the worst
+        # component's error.
         more = weights_of(_select(gram, rhs, norm, allowed, upper, cost, budget + extra_budget, goal**2, caps))
         if worst_component(more[2:]) < worst_component((residual, reference)):
             basis_kept, weights, residual, reference = more
