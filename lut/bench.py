@@ -277,8 +277,9 @@ def binned_error(theta_l, theta_v, phi, rendered, model, min_pixels=3):
     nodes), each bin's mean rendered and model radiance compared, and the
     bins weighted by cos θl as the acceptance measure weights its grid
     points (samples within ``MIRROR_DISTANCE`` of the mirror direction left
-    out, as the grid stays that far from it): sqrt(Σ cos²θl·|mean rendered − mean model|² / Σ cos²θl·|mean
-    model|²) over bins with at least ``min_pixels`` samples, all channels.
+    out, as the grid stays that far from it):
+    sqrt(Σ cos²θl·|mean rendered − mean model|² / Σ cos²θl·|mean model|²)
+    over bins with at least ``min_pixels`` samples, all channels.
     ``rendered`` and ``model`` are radiances (N, 3) per unit irradiance
     (f·cos θl).  Returns (error, bins used)."""
     theta_l, theta_v, phi = (np.asarray(a, dtype=float).ravel() for a in (theta_l, theta_v, phi))

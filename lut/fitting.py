@@ -142,11 +142,7 @@ class Fit:
 
     def component_errors(self) -> dict:
         """The relative error of each component alone (None where it is nil)."""
-        out = {}
-        for c, name in enumerate(COMPONENTS):
-            ref = self.reference[:, c, c].sum()
-            out[name] = float(np.sqrt(self.residual[:, c, c].sum() / ref)) if ref > 0 else None
-        return out
+        return component_errors(self.residual, self.reference)
 
     def error(self, amplitudes) -> float:
         """Cos-weighted relative RMS on the acceptance grid of a paint with
@@ -171,6 +167,16 @@ class Fit:
             "lut_key": self.lut_key,
             "calibration": list(self.calibration) if self.calibration else None,
         }
+
+
+def component_errors(residual, reference) -> dict:
+    """{component: relative error of that component alone} from acceptance
+    Gram matrices (T, C, C), summed over tiles; None where it is nil."""
+    out = {}
+    for c, name in enumerate(COMPONENTS):
+        ref = reference[:, c, c].sum()
+        out[name] = float(np.sqrt(residual[:, c, c].sum() / ref)) if ref > 0 else None
+    return out
 
 
 def acceptance_error(residual, reference, amplitudes) -> float:
@@ -449,9 +455,7 @@ def fit_lut(
     def worst_component(grams):
         """The largest relative error of one component (the error of the
         type's worst colour, where that component dominates)."""
-        residual, reference = grams
-        ref = reference.sum(axis=0).diagonal()
-        return float(np.max(np.sqrt(residual.sum(axis=0).diagonal()[ref > 0] / ref[ref > 0]), initial=0.0))
+        return max((e for e in component_errors(*grams).values() if e is not None), default=0.0)
 
     chosen = _select(gram, rhs, norm, allowed, upper, cost, budget, goal**2, caps)
     basis_kept, weights, residual, reference = weights_of(chosen)

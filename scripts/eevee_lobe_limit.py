@@ -50,29 +50,27 @@ def facet_rows(table, basis, evaluate):
     )
 
 
+def _relative_error(gram, rhs, norm, idx):
+    """Relative squared error of one view's non-negative fit on ``idx``."""
+    g, b = gram[np.ix_(idx, idx)], rhs[idx]
+    x = nnls_gram(g, b)
+    return max((norm - 2 * x @ b + x @ g @ x) / norm, 0.0)
+
+
 def per_view_best(gram, rhs, norm, lobes):
     """Per view, the smallest relative squared error of Lambert (index 0)
     and any two of the ``lobes`` (indices), non-negative weights."""
     best = np.ones(len(norm))
-    for m in range(len(norm)):
-        if norm[m] <= 0:
-            continue
-        for j, k in itertools.combinations(lobes, 2):
-            idx = [0, j, k]
-            g, b = gram[m][np.ix_(idx, idx)], rhs[m][idx]
-            x = nnls_gram(g, b)
-            best[m] = min(best[m], (norm[m] - 2 * x @ b + x @ g @ x) / norm[m])
-    return np.maximum(best, 0.0)
+    for m in np.nonzero(norm > 0)[0]:
+        best[m] = min(_relative_error(gram[m], rhs[m], norm[m], [0, j, k]) for j, k in itertools.combinations(lobes, 2))
+    return best
 
 
 def fitted(gram, rhs, norm, idx):
     """Per view relative squared error of the non-negative fit on ``idx``."""
     out = np.ones(len(norm))
-    for m in range(len(norm)):
-        if norm[m] > 0:
-            g, b = gram[m][np.ix_(idx, idx)], rhs[m][idx]
-            x = nnls_gram(g, b)
-            out[m] = max((norm[m] - 2 * x @ b + x @ g @ x) / norm[m], 0.0)
+    for m in np.nonzero(norm > 0)[0]:
+        out[m] = _relative_error(gram[m], rhs[m], norm[m], idx)
     return out
 
 
