@@ -173,7 +173,9 @@ def build_group(fit: fitting.Fit, weights_path, exact_metallic=None):
         coord.label = f"{fit.closures[k].kind} {fitting.COMPONENTS[c]}"
         tex = lay.place(tree.nodes.new("ShaderNodeTexImage"), "weights", "Weights per view")
         tex.image = image
-        tex.interpolation = "Linear"
+        # Closest: the texture's columns are dense (fitting.TEXTURE_VIEWS);
+        # Linear would let EEVEE's mipmaps blend the rows of other closures.
+        tex.interpolation = "Closest"
         tex.extension = "EXTEND"
         links.new(coord.outputs[0], tex.inputs["Vector"])
         textures[(k, c)] = tex.outputs["Color"]
@@ -224,7 +226,8 @@ def _interface(group):
 
 def _view_lookup(tree, links, lay, views):
     """u = cos θv mapped onto texel centres: column j at u = (j + 0.5)/M
-    holds cos θv = j/(M - 1)."""
+    holds cos θv = j/(M - 1), so a Closest lookup reads the column nearest
+    to cos θv."""
     geometry = lay.place(tree.nodes.new("ShaderNodeNewGeometry"), "view", "View angle")
     dot = lay.place(tree.nodes.new("ShaderNodeVectorMath"), "view", "View angle")
     dot.operation = "DOT_PRODUCT"

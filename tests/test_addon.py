@@ -239,8 +239,12 @@ def test_bake_wires_a_group_per_engine_with_colour_inputs(material, lut_dir):
         source = output.inputs["Surface"].links[0].from_node
         assert source.type == "GROUP" and source.node_tree.name.startswith("Paint LUT n1.5 smooth")
         assert [s.name for s in source.inputs] == list(nodes.INPUTS)
-        image = next(nd.image for nd in source.node_tree.nodes if nd.type == "TEX_IMAGE")
-        assert image.colorspace_settings.name == "Non-Color"
+        textures = [nd for nd in source.node_tree.nodes if nd.type == "TEX_IMAGE"]
+        assert textures[0].image.colorspace_settings.name == "Non-Color"
+        # Read by nearest column on the dense texture: EEVEE's mipmaps would
+        # blend the rows of other closures into a Linear lookup.
+        assert {nd.interpolation for nd in textures} == {"Closest"}
+        assert textures[0].image.size[0] == fitting.TEXTURE_VIEWS
     eevee = _group_node(material, "EEVEE").node_tree
     assert not any(nd.type == "BSDF_TOON" for nd in eevee.nodes)  # EEVEE draws Toon closures as Lambert
     assert any(nd.type == "BSDF_TOON" for nd in _group_node(material).node_tree.nodes)

@@ -129,6 +129,32 @@ def test_fit_error_from_its_matrices_is_the_error_of_the_fitted_closures(luts):
     assert fitted.error(amps) == pytest.approx(direct, rel=1e-6)
 
 
+def test_nearest_column_of_the_weights_texture_renders_the_reported_error(luts):
+    """The node group reads the weights texture by its nearest column
+    (Closest interpolation, which EEVEE samples without mipmaps): that
+    lookup renders the error the fit reports, and every
+    ``VIEW_SUBDIVISION``-th column is a fitted view with the columns between
+    on the straight line between its neighbours."""
+    fitted = fitting.fit_lut(luts["dark satin"], "CYCLES")
+    assert len(fitted.cos_view) == fitting.TEXTURE_VIEWS
+    paint = lut.Paint(rho=(0.6, 0.1, 0.02), single=(0.0, 0.2, 0.1), g=0.0, slope=0.45, facet=0.8)
+    tl, tv, ph = (a.ravel() for a in np.meshgrid(*fitting.ACCEPTANCE_GRID, indexing="ij"))
+    ref = luts["dark satin"].evaluate(tl, tv, ph, paint) * np.cos(tl)[:, None]
+    amps = luts["dark satin"].amplitudes(paint)
+
+    j = np.rint(np.cos(tv) * (len(fitted.cos_view) - 1)).astype(int)  # the nearest column
+    got = np.zeros_like(ref)
+    for k, closure in enumerate(fitted.closures):
+        got += closure.evaluate(tl, tv, ph)[:, None] * (fitted.weights[k][:, j, 0].T @ amps.T)
+    wt = np.cos(tl)[:, None]
+    nearest = np.sqrt(np.sum(((got - ref) * wt) ** 2) / np.sum((ref * wt) ** 2))
+    assert nearest == pytest.approx(fitted.error(amps), abs=0.002)
+    views = fitted.weights[:, :, :: fitting.VIEW_SUBDIVISION]
+    assert views.shape[2] == fitting.VIEWS
+    between = fitting.resample_views(views, fitting.view_cosines(), fitted.cos_view)
+    np.testing.assert_allclose(fitted.weights, between, rtol=1e-12, atol=1e-15)
+
+
 def test_facet_dominated_dark_paints_keep_facet_closures(luts):
     """Dark paints are mostly facet reflection: forward selection keeps the
     closures that fit it (energy ranking once dropped them all)."""
