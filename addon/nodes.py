@@ -351,6 +351,19 @@ def _retro(tree, links, lay, closure, rows_k, amps, exact_metallic):
     return node.outputs[0]
 
 
+def _retro_glossy(tree, links, lay, closure, rows_k, amps, exact_metallic):
+    """A GGX Glossy BSDF whose normal is the view direction: a retro lobe
+    that EEVEE draws as a reflection closure."""
+    node = lay.place(tree.nodes.new("ShaderNodeBsdfGlossy"), "closures", "Closures")
+    node.distribution = "GGX"
+    node.inputs["Roughness"].default_value = closure.roughness
+    node.label = f"retro lobe {closure.roughness:.3g}"
+    incoming = lay.place(tree.nodes.new("ShaderNodeNewGeometry"), "mix", "Closure colours")
+    links.new(incoming.outputs["Incoming"], node.inputs["Normal"])
+    links.new(_colour(tree, links, lay, rows_k, amps), node.inputs["Color"])
+    return node.outputs[0]
+
+
 def _setup_glossy(node, closure):
     node.distribution = "BECKMANN"
     node.inputs["Roughness"].default_value = closure.roughness
@@ -423,6 +436,7 @@ NODE_BUILDERS = {
     "metallic": _grey(_metallic_node),
     "ggx": _grey(_principled_node),
     "oren_nayar": _oren_nayar,
+    "retro_glossy": _retro_glossy,
 }
 assert set(NODE_BUILDERS) == set(closures.CLOSURE_KINDS)
 

@@ -33,6 +33,12 @@ irradiance, cos θl included (what Cycles' eval returns), for a white closure:
   the paper's Gaussian facet term (Eq. 31 with Eq. 33) times G.  A *grey*
   closure: it has no colour input, so its weight is one number for all
   channels (a Mix Shader factor in the node group).
+* ``retro_glossy``: Glossy BSDF, GGX of roughness r, whose Normal input is
+  the view direction (Geometry › Incoming): the white GGX lobe
+  D·G/(4 cos θv') in the frame of that normal, where θv' = 0 and the light
+  is at the angle γ between l and v: a retro-reflection lobe that EEVEE
+  draws as a reflection closure (``lut.eevee``; EEVEE draws the retro Toon
+  as Lambert about the view, a diffuse closure of a normal of its own).
 * ``ggx``:          Principled BSDF with a black base and GGX roughness r: its
   dielectric specular layer alone, F·D_GGX(α = r²)·G/(4 cos θv) with the
   height-correlated Smith G of GGX (Walter et al. 2007, Eqs. 33-34).  Grey.
@@ -178,18 +184,16 @@ def _metallic(closure, theta_l, theta_v, phi):
     return f * np.cos(theta_l) * g
 
 
-def _ggx(closure, theta_l, theta_v, phi):
-    """GGX microfacet reflection with exact unpolarized dielectric Fresnel,
-    per unit irradiance, cos θl included: F·D·G/(4 cos θv) (Walter et al.
-    2007, Eqs. 33-34, with the height-correlated Smith G)."""
-    alpha = max(closure.roughness, 1e-3) ** 2
+def ggx_lobe(theta_l, theta_v, phi, roughness):
+    """The white GGX lobe D·G/(4 cos θv) of α = r², cos θl included, with
+    the height-correlated Smith G (Walter et al. 2007, Eqs. 33-34), and
+    cos θd (for a Fresnel factor): (lobe, cos θd)."""
+    alpha = max(float(roughness), 1e-3) ** 2
     cos_h, cos_d = _half_vector(theta_l, theta_v, phi)
     cos_h = np.maximum(cos_h, 1e-12)
     a2 = alpha * alpha
     tan2_h = (1.0 - cos_h * cos_h) / (cos_h * cos_h)
     d = a2 / (np.pi * cos_h**4 * (a2 + tan2_h) ** 2)
-    rs, rp = fresnel.reflection_coefficients(cos_d, closure.ior)
-    f = 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)
 
     def lam(theta):
         t = np.tan(np.minimum(theta, np.pi / 2 - 1e-9))
@@ -197,7 +201,33 @@ def _ggx(closure, theta_l, theta_v, phi):
 
     g = 1.0 / (1.0 + lam(theta_l) + lam(theta_v))
     up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2)
-    return np.where(up, f * d * g / (4.0 * np.maximum(np.cos(theta_v), 1e-12)), 0.0)
+    return np.where(up, d * g / (4.0 * np.maximum(np.cos(theta_v), 1e-12)), 0.0), cos_d
+
+
+def _ggx(closure, theta_l, theta_v, phi):
+    """GGX microfacet reflection with exact unpolarized dielectric Fresnel,
+    per unit irradiance, cos θl included: F·D·G/(4 cos θv) (Walter et al.
+    2007, Eqs. 33-34, with the height-correlated Smith G)."""
+    lobe, cos_d = ggx_lobe(theta_l, theta_v, phi, closure.roughness)
+    rs, rp = fresnel.reflection_coefficients(cos_d, closure.ior)
+    return lobe * 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)
+
+
+def light_view_angle(theta_l, theta_v, phi):
+    """The angle γ between the light (-sin θl, 0, cos θl) and the view
+    (sin θv cos φ, sin θv sin φ, cos θv)."""
+    cos_lv = -np.sin(theta_l) * np.sin(theta_v) * np.cos(phi) + np.cos(theta_l) * np.cos(theta_v)
+    return np.arccos(np.clip(cos_lv, -1.0, 1.0))
+
+
+def _retro_glossy(closure, theta_l, theta_v, phi):
+    """GGX lobe about the view direction: in the frame of that normal the
+    viewer is at θv' = 0 and the light at γ (``light_view_angle``); lights
+    below the surface stay dark."""
+    gamma = light_view_angle(theta_l, theta_v, phi)
+    zero = np.zeros_like(gamma)
+    lobe, _ = ggx_lobe(gamma, zero, zero, closure.roughness)
+    return np.where((theta_l < np.pi / 2) & (theta_v < np.pi / 2), lobe, 0.0)
 
 
 def _sheen(closure, theta_l, theta_v, phi):
@@ -270,6 +300,7 @@ CLOSURE_KINDS = {
     "oren_nayar": ClosureKind(_oren_nayar, cost=3),
     "metallic": ClosureKind(_metallic, grey=True),
     "ggx": ClosureKind(_ggx, grey=True),
+    "retro_glossy": ClosureKind(_retro_glossy),
 }
 
 
@@ -320,6 +351,11 @@ def _lobes(type_dict, exact_metallic):
     return [Closure(grey, ior=n, roughness=r) for r in rough] + [Closure("glossy", roughness=r) for r in rough]
 
 
+#: Roughnesses of the retro GGX lobes an EEVEE fit of a smooth type may use
+#: (calibrated in ``lut.eevee``).
+RETRO_ROUGHNESS = (0.45, 0.6, 0.8, 1.0)
+
+
 def candidates(type_dict: dict, target: str = "CYCLES", exact_metallic: bool = True) -> list:
     """The closures a paint type may be fitted with on a render target:
     Lambert; for Cycles the Toon ramps (the subsurface terms' light-side
@@ -331,7 +367,10 @@ def candidates(type_dict: dict, target: str = "CYCLES", exact_metallic: bool = T
     (``exact_metallic``: Blender 5), Principled GGX otherwise (Blender
     4.2-4.5); for Cycles above a slope of 0.3 also velvet Sheen lobes, which
     rise toward grazing as very rough facet terms do.  EEVEE draws every
-    diffuse closure as Lambert (``lut.eevee``): Lambert and the lobes."""
+    diffuse closure as Lambert (``lut.eevee``): Lambert and the lobes; for
+    a smooth type, whose mirror leaves one of EEVEE's two exact reflection
+    closures free, retro GGX lobes (``retro_glossy``) for back-scattering
+    pigments."""
     target = validate_target(target)
     basis = [Closure("lambert")]
     if target == "CYCLES":
@@ -339,6 +378,8 @@ def candidates(type_dict: dict, target: str = "CYCLES", exact_metallic: bool = T
         basis += [Closure("oren_nayar", roughness=r) for r in (0.5, 1.0)]
         basis += [Closure("retro_toon", a, s) for a in (0.15, 0.3, 0.5) for s in (0.2, 0.6)]
     basis += _lobes(type_dict, exact_metallic)
+    if target == "EEVEE" and float(type_dict["slope"]) == 0:
+        basis += [Closure("retro_glossy", roughness=r) for r in RETRO_ROUGHNESS]
     if target == "CYCLES" and float(type_dict["slope"]) > 0.3:
         basis += [Closure("sheen", roughness=r) for r in (0.3, 0.5, 0.8, 1.0)]
     return basis

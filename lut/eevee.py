@@ -23,6 +23,9 @@ The references (what EEVEE was found to approximate):
   EEVEE draws Beckmann lobes as GGX.
 * ``metallic``: the same times the exact unpolarized dielectric Fresnel
   reflectance at the half vector, F(θd, n) (``lut.models.fresnel``).
+* ``retro_glossy``: the GGX lobe in the frame of its normal, the view
+  direction (``lut.closures``: viewer at θv' = 0, light at the angle γ
+  between l and v).
 
 Between the calibrated roughnesses ``ROUGHNESS`` (and IORs ``IORS`` of the
 Metallic BSDF) the ratio tables are interpolated linearly, the reference
@@ -36,17 +39,18 @@ import io
 
 import numpy as np
 
-from .closures import Closure
+from .closures import RETRO_ROUGHNESS, Closure, ggx_lobe, light_view_angle
 from .models import fresnel
 
 #: The grid of the tables: θl and θv in 5° steps to 90°, |φ| in 15° steps.
 THETA = np.radians(np.arange(0.0, 90.1, 5.0))
 PHI = np.radians(np.arange(0.0, 180.1, 15.0))
-#: Calibrated roughnesses (glossy, metallic) and Metallic BSDF IORs.
+#: Calibrated roughnesses (glossy, metallic; the retro GGX lobes at
+#: ``lut.closures.RETRO_ROUGHNESS``) and Metallic BSDF IORs.
 ROUGHNESS = (0.05, 0.1, 0.2, 0.3, 0.45, 0.6, 0.8, 1.0)
 IORS = (1.33, 1.5, 1.7, 2.0)
 #: Kinds with tables (the closure kinds an EEVEE fit may use).
-KINDS = ("lambert", "oren_nayar", "sheen", "retro_toon", "glossy", "metallic")
+KINDS = ("lambert", "oren_nayar", "sheen", "retro_toon", "glossy", "metallic", "retro_glossy")
 
 #: What EEVEE (Blender 5.0, one sample per pixel) sums exactly, measured by
 #: scripts/eevee_additivity.py: diffuse closures sharing the surface normal
@@ -65,7 +69,7 @@ def table_key(closure: Closure) -> str:
     rendering of it was measured over."""
     if closure.kind == "metallic":
         return f"metallic/{closure.ior:g}/{closure.roughness:g}"
-    if closure.kind in ("glossy", "oren_nayar", "sheen"):
+    if closure.kind in ("glossy", "oren_nayar", "sheen", "retro_glossy"):
         return f"{closure.kind}/{closure.roughness:g}"
     if closure.kind == "retro_toon":
         return f"retro_toon/{closure.size:g}/{closure.smooth:g}"
@@ -73,29 +77,6 @@ def table_key(closure: Closure) -> str:
 
 
 # ---------------------------------------------------------------------- references
-
-
-def _ggx_lobe(theta_l, theta_v, phi, roughness):
-    """D·G/(4 cos θv) of GGX, α = r², cos θl included, and cos θd (Walter
-    et al. 2007, Eqs. 33-34; height-correlated Smith G)."""
-    alpha = max(float(roughness), 1e-3) ** 2
-    sl, cl = np.sin(theta_l), np.cos(theta_l)
-    sv, cv = np.sin(theta_v), np.cos(theta_v)
-    hx, hy, hz = sv * np.cos(phi) - sl, sv * np.sin(phi), cv + cl
-    norm = np.maximum(np.sqrt(hx * hx + hy * hy + hz * hz), 1e-300)
-    cos_h = np.maximum(hz / norm, 1e-12)
-    cos_d = np.clip((-sl * hx + cl * hz) / norm, 0.0, 1.0)
-    a2 = alpha * alpha
-    tan2_h = (1.0 - cos_h * cos_h) / (cos_h * cos_h)
-    d = a2 / (np.pi * cos_h**4 * (a2 + tan2_h) ** 2)
-
-    def lam(theta):
-        t = np.tan(np.minimum(theta, np.pi / 2 - 1e-9))
-        return 0.5 * (np.sqrt(1.0 + a2 * t * t) - 1.0)
-
-    g = 1.0 / (1.0 + lam(theta_l) + lam(theta_v))
-    up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2)
-    return np.where(up, d * g / (4.0 * np.maximum(cv, 1e-12)), 0.0), cos_d
 
 
 def reference(closure: Closure, theta_l, theta_v, phi):
@@ -107,8 +88,12 @@ def reference(closure: Closure, theta_l, theta_v, phi):
     if kind == "retro_toon":
         cos_lv = -np.sin(theta_l) * np.sin(theta_v) * np.cos(phi) + np.cos(theta_l) * np.cos(theta_v)
         return np.maximum(cos_lv, 0.0) / np.pi
+    if kind == "retro_glossy":
+        gamma = light_view_angle(theta_l, theta_v, phi)
+        zero = np.zeros_like(gamma)
+        return np.where(theta_l < np.pi / 2, ggx_lobe(gamma, zero, zero, closure.roughness)[0], 0.0)
     if kind in ("glossy", "metallic"):
-        lobe, cos_d = _ggx_lobe(theta_l, theta_v, phi, closure.roughness)
+        lobe, cos_d = ggx_lobe(theta_l, theta_v, phi, closure.roughness)
         if kind == "glossy":
             return lobe
         rs, rp = fresnel.reflection_coefficients(cos_d, closure.ior)
@@ -225,10 +210,10 @@ def ratio(closure: Closure, theta_l, theta_v, phi, version=(5, 0)):
         keys = {k: 1.0 for k in data if k == kind or k.startswith(kind + "/")}
     elif kind == "retro_toon":
         keys = {k: 1.0 for k in data if k.startswith("retro_toon/")}
-    elif kind == "glossy":
-        lo, hi, t = _bracket(ROUGHNESS, closure.roughness)
-        keys = {f"glossy/{lo:g}": 1.0 - t}
-        keys[f"glossy/{hi:g}"] = keys.get(f"glossy/{hi:g}", 0.0) + t
+    elif kind in ("glossy", "retro_glossy"):
+        lo, hi, t = _bracket(ROUGHNESS if kind == "glossy" else RETRO_ROUGHNESS, closure.roughness)
+        keys = {f"{kind}/{lo:g}": 1.0 - t}
+        keys[f"{kind}/{hi:g}"] = keys.get(f"{kind}/{hi:g}", 0.0) + t
     elif kind == "metallic":
         r_lo, r_hi, t = _bracket(ROUGHNESS, closure.roughness)
         n_lo, n_hi, s = _bracket(IORS, closure.ior)
@@ -271,4 +256,4 @@ def calibration_for(blender_version):
 def is_reflection(closure: Closure) -> bool:
     """Whether EEVEE counts the closure as a reflection closure (its
     microfacet lobes) rather than a diffuse one (``EXACT_REFLECTION_CLOSURES``)."""
-    return closure.kind in ("glossy", "metallic", "ggx")
+    return closure.kind in ("glossy", "metallic", "ggx", "retro_glossy")

@@ -460,8 +460,10 @@ def fit_lut(
         from . import eevee
 
         # EEVEE sums one diffuse normal and two reflection closures exactly
-        # per pixel; beyond that it picks closures at random (noise).
-        caps = (np.array([eevee.is_reflection(c) for c in basis]), eevee.EXACT_REFLECTION_CLOSURES)
+        # per pixel; beyond that it picks closures at random (noise).  A
+        # smooth type's mirror is one of the two.
+        mirror = float(type_dict["slope"]) == 0.0
+        caps = (np.array([eevee.is_reflection(c) for c in basis]), eevee.EXACT_REFLECTION_CLOSURES - mirror)
 
     def weights_of(chosen):
         """NNLS weights of the chosen closures, the kept closures and their

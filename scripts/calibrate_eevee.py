@@ -16,7 +16,8 @@ and lobes of any roughness keep their analytic shape between cells.
 
 Run ``python scripts/calibrate_eevee.py`` with a Python whose ``bpy`` renders
 EEVEE; the tables of that Blender line (``bpy.app.version[:2]``) are added to
-the file, those of other lines kept."""
+the file, those of other lines kept (``--only KIND ...``: only those kinds
+are measured, and added to the line's other tables)."""
 
 from __future__ import annotations
 
@@ -35,7 +36,7 @@ if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
 from lut import eevee, files  # noqa: E402
-from lut.closures import Closure  # noqa: E402
+from lut.closures import RETRO_ROUGHNESS, Closure  # noqa: E402
 
 #: The generated module of tables.
 MODULE = ROOT / "lut" / "eevee_tables.py"
@@ -53,6 +54,7 @@ def calibration_closures() -> list:
     out += [Closure("glossy", roughness=r) for r in eevee.ROUGHNESS]
     out += [Closure("metallic", ior=n, roughness=r) for n in eevee.IORS for r in eevee.ROUGHNESS]
     out += [Closure("oren_nayar", roughness=1.0), Closure("sheen", roughness=0.5)]
+    out += [Closure("retro_glossy", roughness=r) for r in RETRO_ROUGHNESS]
     return out
 
 
@@ -89,6 +91,11 @@ def closure_shader(tree, closure: Closure, weight: float = 1.0):
         node = nodes.new("ShaderNodeBsdfGlossy")
         node.distribution = "BECKMANN"
         node.inputs["Roughness"].default_value = closure.roughness
+    elif kind == "retro_glossy":
+        node = nodes.new("ShaderNodeBsdfGlossy")
+        node.distribution = "GGX"
+        node.inputs["Roughness"].default_value = closure.roughness
+        links.new(nodes.new("ShaderNodeNewGeometry").outputs["Incoming"], node.inputs["Normal"])
     elif kind == "sheen":
         node = nodes.new("ShaderNodeBsdfSheen")
         node.distribution = "ASHIKHMIN"
@@ -164,16 +171,13 @@ class SphereScene:
         self.sun.data.use_shadow = False
         self.scene, self.cell, self.columns, self.rows = scene, cell, columns, rows
         self._path = os.path.join(tempfile.mkdtemp(prefix="eevee_calibration"), "render.exr")
+        self._normal = None
 
-    def render(self, gamma, erode=0):
-        """Per sphere: (θl, θv, φ, radiance (N, 3)) of its lit pixels, for the
-        light at angle ``gamma`` from the view (in the XZ plane) and unit
-        irradiance; ``erode``: leave out pixels within that many of the
-        sphere's silhouette (EEVEE shades them unlike the surface inside)."""
+    def _layers(self):
+        """Render and read the passes: {pass.channel: (H, W) array}."""
         import bpy
         import OpenImageIO as oiio
 
-        self.sun.rotation_euler = (0.0, -gamma, 0.0)
         self.scene.render.filepath = self._path
         bpy.ops.render.render(write_still=True)
         layers = {}
@@ -182,8 +186,35 @@ class SphereScene:
             pixels = buf.get_pixels(oiio.FLOAT)
             for i, name in enumerate(buf.spec().channelnames):
                 layers[name.split(".", 1)[-1]] = pixels[..., i].astype(float)
+        return layers
+
+    def surface_normals(self):
+        """The spheres' shading normals (H, W, 3), rendered once with every
+        material replaced by a Diffuse BSDF: the Normal pass of a material
+        reports its closures' normals, which for a lobe about the view
+        direction (``retro_toon``, ``retro_glossy``) is not the surface's."""
+        if self._normal is None:
+            import bpy
+
+            plain = bpy.data.materials.get("Paint LUT plain") or bpy.data.materials.new("Paint LUT plain")
+            layer = self.scene.view_layers[0]
+            layer.material_override = plain
+            try:
+                layers = self._layers()
+            finally:
+                layer.material_override = None
+            self._normal = np.stack([layers[f"Normal.{c}"] for c in "XYZ"], -1)
+        return self._normal
+
+    def render(self, gamma, erode=0):
+        """Per sphere: (θl, θv, φ, radiance (N, 3)) of its lit pixels, for the
+        light at angle ``gamma`` from the view (in the XZ plane) and unit
+        irradiance; ``erode``: leave out pixels within that many of the
+        sphere's silhouette (EEVEE shades them unlike the surface inside)."""
+        normal = self.surface_normals()
+        self.sun.rotation_euler = (0.0, -gamma, 0.0)
+        layers = self._layers()
         rgb = np.stack([layers[f"Combined.{c}"] for c in "RGB"], -1)
-        normal = np.stack([layers[f"Normal.{c}"] for c in "XYZ"], -1)
         light = np.array([-math.sin(gamma), 0.0, math.cos(gamma)])
         out = []
         for row, col in self.cells:
@@ -242,15 +273,18 @@ def bin_ratios(samples, closure):
     return ratio, count
 
 
-def write_module(path, version, tables):
+def write_module(path, version, tables, merge=False):
     """Write ``lut/eevee_tables.py``: the tables of ``version`` replace that
-    line's, other lines' are kept."""
+    line's (``merge``: are added to that line's, replacing only those of the
+    same keys), other lines' are kept."""
     path = pathlib.Path(path)
     stored = {}
     if path.exists():
         scope = {}
         exec(compile(path.read_text(), str(path), "exec"), scope)
         stored = dict(scope["TABLES"])
+    if merge and version in stored:
+        tables = {**eevee.decode(stored[version]), **tables}
     stored[version] = eevee.encode(tables)
     lines = [
         '"""EEVEE calibration tables by Blender line, made by scripts/calibrate_eevee.py',
@@ -293,8 +327,11 @@ def main(argv=None):
     parser.add_argument("--per-render", type=int, default=25, help="spheres per render")
     parser.add_argument("--raw", type=pathlib.Path, help="also keep the pixels' samples in this .npz")
     parser.add_argument("--from-raw", type=pathlib.Path, help="make the tables from samples kept by --raw")
+    parser.add_argument(
+        "--only", nargs="+", metavar="KIND", help="measure only these closure kinds, keeping the line's other tables"
+    )
     args = parser.parse_args(argv)
-    todo = calibration_closures()
+    todo = [c for c in calibration_closures() if not args.only or c.kind in args.only]
     if args.from_raw:
         raw = np.load(args.from_raw)
         version = str(raw["version"])
@@ -308,7 +345,7 @@ def main(argv=None):
             flat = {f"{eevee.table_key(c)}/{j}": s[j] for c, s in zip(todo, samples, strict=True) for j in range(4)}
             np.savez_compressed(args.raw, version=version, **flat)
     tables = {eevee.table_key(c): eevee.fill(bin_ratios([s], c)[0]) for c, s in zip(todo, samples, strict=True)}
-    write_module(args.out, version, tables)
+    write_module(args.out, version, tables, merge=bool(args.only))
     print(f"wrote {len(tables)} tables for Blender {version} to {args.out}")
 
 

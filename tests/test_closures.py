@@ -99,6 +99,25 @@ def test_candidates_per_target():
     assert {c.kind for c in closures.candidates(satin, exact_metallic=False) if c.grey} == {"ggx"}
     smooth = {"n": 1.5, "g": 0.0, "slope": 0.0, "distribution": "gaussian"}
     assert not any(c.grey for c in closures.candidates(smooth))  # a smooth facet term is the mirror
+    # EEVEE: a smooth type's mirror leaves one reflection closure free, for a retro lobe.
+    assert {c.kind for c in closures.candidates(smooth, "EEVEE")} == {"lambert", "retro_glossy"}
+    assert "retro_glossy" not in {c.kind for c in closures.candidates(smooth)}
+
+
+def test_retro_glossy_is_a_ggx_lobe_about_the_view():
+    """Its value depends on the light-view angle alone (the lobe's frame is
+    the view direction), peaks with the light at the viewer, and is the GGX
+    lobe seen head-on there."""
+    lobe = closures.Closure("retro_glossy", roughness=0.6)
+    tl = np.radians([10.0, 40.0, 70.0])
+    at_viewer = lobe.evaluate(tl, tl, np.pi)  # light and view together
+    head_on, _ = closures.ggx_lobe(0.0, 0.0, 0.0, 0.6)
+    np.testing.assert_allclose(at_viewer, head_on, rtol=1e-9)
+    # The same light-view angle (40°) from different geometries, the same value.
+    a = lobe.evaluate(np.radians(20.0), np.radians(20.0), 0.0)  # mirror geometry, γ = 40°
+    b = lobe.evaluate(np.radians(40.0), 0.0, 0.0)  # view along the normal, γ = 40°
+    assert a == pytest.approx(b, rel=1e-9) and a < 0.5 * head_on
+    assert lobe.evaluate(np.radians(95.0), 0.2, 0.0) == 0.0
 
 
 @pytest.fixture(scope="module")

@@ -81,6 +81,7 @@ EVERY_KIND = [
     closures.Closure("oren_nayar", roughness=1.0),
     closures.Closure("metallic", ior=1.6, roughness=0.4),
     closures.Closure("ggx", ior=1.4, roughness=0.6),
+    closures.Closure("retro_glossy", roughness=0.7),
 ]
 
 #: Colour inputs that make one component's amplitude exactly 1.

@@ -21,6 +21,7 @@ CLOSURES = [
     Closure("metallic", ior=1.6, roughness=0.25),
     Closure("oren_nayar", roughness=0.5),
     Closure("sheen", roughness=0.8),
+    Closure("retro_glossy", roughness=0.7),
 ]
 
 
@@ -40,7 +41,7 @@ def test_symmetric_finite_and_broadcast(closure, version):
     )
 
 
-@pytest.mark.parametrize("closure", CLOSURES[:6], ids=lambda c: eevee.table_key(c))
+@pytest.mark.parametrize("closure", CLOSURES[:6] + CLOSURES[-1:], ids=lambda c: eevee.table_key(c))
 def test_smooth_in_angles_and_parameters(closure):
     """No jumps: a small step in any angle (or roughness) changes the value
     by a small fraction of the lobe's peak."""
@@ -51,7 +52,7 @@ def test_smooth_in_angles_and_parameters(closure):
     for d in (np.array([1e-3, 0, 0]), np.array([0, 1e-3, 0]), np.array([0, 0, 1e-3])):
         step = eevee.evaluate(closure, tl + d[0], tv + d[1], ph + d[2])
         assert np.max(np.abs(step - base)) < 0.02 * peak
-    if closure.kind in ("glossy", "metallic"):
+    if closure.kind in ("glossy", "metallic", "retro_glossy"):
         import dataclasses
 
         near = dataclasses.replace(closure, roughness=closure.roughness + 1e-3)
@@ -89,7 +90,7 @@ def test_uncalibrated_kinds_and_versions_raise():
             eevee.evaluate(Closure(kind), 0.3, 0.3, 0.0)
     with pytest.raises(ValueError, match="3.6"):
         eevee.evaluate(Closure("lambert"), 0.3, 0.3, 0.0, version=(3, 6))
-    assert set(eevee.KINDS) <= {"lambert", "oren_nayar", "sheen", "retro_toon", "glossy", "metallic"}
+    assert set(eevee.KINDS) <= {"lambert", "oren_nayar", "sheen", "retro_toon", "glossy", "metallic", "retro_glossy"}
     assert (5, 0) in eevee.available_versions()
 
 
@@ -114,6 +115,7 @@ def oracle():
         Closure("retro_toon", 0.3, 0.2),
         Closure("glossy", roughness=0.4),
         Closure("metallic", ior=1.6, roughness=0.5),
+        Closure("retro_glossy", roughness=0.7),
     ],
     ids=lambda c: eevee.table_key(c),
 )
