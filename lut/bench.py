@@ -7,7 +7,7 @@ import time
 
 import numpy as np
 
-from . import models
+from . import fitting, models
 from .models import reference
 
 CLOSED_FORM = {
@@ -221,6 +221,32 @@ def random_paints(count=24, seed=2026):
     return out
 
 
+def dark_paints(count=24, seed=2027):
+    """A randomised set of dark rough paints, dominated by the facet term
+    (fixed seed): ρ per channel log-uniform over 0.01-0.05, single
+    scattering 0-0.03 per channel, g uniform over -0.7..0.8, n 1.3-2.0,
+    slopes log-uniform over 0.05-3 with either distribution (alternating),
+    surface reflection 0.5-1.  The corner of the panel where the render path
+    shows the facet term almost alone.  Returns [(label, lut.Paint)]."""
+    from .paint import Paint
+
+    rng = np.random.default_rng(seed)
+    out = []
+    for i in range(count):
+        distribution = "gaussian" if i % 2 == 0 else "exponential"
+        paint = Paint(
+            n=round(float(rng.uniform(1.3, 2.0)), 3),
+            rho=tuple(round(float(v), 4) for v in np.exp(rng.uniform(np.log(0.01), np.log(0.05), 3))),
+            single=tuple(round(float(v), 4) for v in rng.uniform(0.0, 0.03, 3)),
+            g=round(float(rng.uniform(-0.7, 0.8)), 3),
+            slope=round(float(np.exp(rng.uniform(np.log(0.05), np.log(3.0)))), 4),
+            distribution=distribution,
+            facet=round(float(rng.uniform(0.5, 1.0)), 3),
+        )
+        out.append((f"dark #{i} {distribution[:3]} {paint.slope:g} g {paint.g:+.2f}", paint))
+    return out
+
+
 def render_bake_times(paints, directory, repeat=1, eevee_calibration=(5, 0)):
     """Seconds of a cold ``lut.render.bake_for_render`` (the paint type's LUT
     and every engine's fit, as the add-on's Bake does) per paint, split into
@@ -259,15 +285,9 @@ BIN_PHI = np.radians(np.arange(20.0, 180.1, 15.0))
 
 #: Samples nearer the mirror direction than this are left out of
 #: ``binned_error``, as the acceptance grid's nearest point (θl = 0, θv =
-#: 5°) is this far from it.
-MIRROR_DISTANCE = np.radians(5.0)
-
-
-def mirror_distance(theta_l, theta_v, phi):
-    """Angle between the view and the mirror direction of the light (light
-    at azimuth π, φ = 0 the mirror's azimuth)."""
-    cos = np.cos(theta_l) * np.cos(theta_v) + np.sin(theta_l) * np.sin(theta_v) * np.cos(phi)
-    return np.arccos(np.clip(cos, -1.0, 1.0))
+#: 5°) is this far from it (the fit's dense measure leaves out the same).
+MIRROR_DISTANCE = fitting.MIRROR_EXCLUSION
+mirror_distance = fitting.mirror_distance
 
 
 def binned_error(theta_l, theta_v, phi, rendered, model, min_pixels=3):

@@ -1,6 +1,8 @@
 """lut.closures, lut.nnls and lut.fitting: closure kinds, non-negative least
 squares, and the fit of a paint type's LUT (numpy side)."""
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -130,22 +132,55 @@ def luts(tmp_path_factory):
     }
 
 
-def test_fit_error_from_its_matrices_is_the_error_of_the_fitted_closures(luts):
-    """Fit.error(amplitudes) (Gram matrices) equals the cos-weighted relative
-    RMS computed directly from the closures, their interpolated weights and
-    the LUT, for any colour."""
-    fitted = fitting.fit_lut(luts["dark satin"], "CYCLES")
-    paint = lut.Paint(rho=(0.6, 0.1, 0.02), single=(0.0, 0.2, 0.1), g=0.0, slope=0.45, facet=0.8)
-    tl, tv, ph = (a.ravel() for a in np.meshgrid(*fitting.ACCEPTANCE_GRID, indexing="ij"))
-    ref = luts["dark satin"].evaluate(tl, tv, ph, paint) * np.cos(tl)[:, None]
-    amps = luts["dark satin"].amplitudes(paint)
+def _direct_error(fitted, table, paint, points, evaluate=None):
+    """The cos-weighted relative RMS at ``points`` computed directly from
+    the closures, their interpolated weights and the LUT."""
+    tl, tv, ph = points
+    ref = table.evaluate(tl, tv, ph, paint) * np.cos(tl)[:, None]
+    amps = table.amplitudes(paint)
     got = np.zeros_like(ref)
     for k, closure in enumerate(fitted.closures):
         w = np.stack([np.interp(np.cos(tv), fitted.cos_view, fitted.weights[k, c, :, 0]) for c in range(3)], -1)
-        got += closure.evaluate(tl, tv, ph)[:, None] * (w @ amps.T)
+        value = closure.evaluate(tl, tv, ph) if evaluate is None else evaluate(closure, tl, tv, ph)
+        got += value[:, None] * (w @ amps.T)
     w = np.cos(tl)[:, None]
-    direct = np.sqrt(np.sum(((got - ref) * w) ** 2) / np.sum((ref * w) ** 2))
-    assert fitted.error(amps) == pytest.approx(direct, rel=1e-6)
+    return np.sqrt(np.sum(((got - ref) * w) ** 2) / np.sum((ref * w) ** 2))
+
+
+def test_fit_error_from_its_matrices_is_the_error_of_the_fitted_closures(luts):
+    """Fit.error(amplitudes) (Gram matrices) is the larger of the
+    cos-weighted relative RMS on the acceptance grid and on the dense grid,
+    each equal to the error computed directly from the closures, their
+    interpolated weights and the LUT, for any colour."""
+    fitted = fitting.fit_lut(luts["dark satin"], "CYCLES")
+    paint = lut.Paint(rho=(0.6, 0.1, 0.02), single=(0.0, 0.2, 0.1), g=0.0, slope=0.45, facet=0.8)
+    amps = luts["dark satin"].amplitudes(paint)
+    grid = _direct_error(fitted, luts["dark satin"], paint, fitting.grid_points())
+    dense = _direct_error(fitted, luts["dark satin"], paint, fitting.dense_points())
+    assert fitting.acceptance_error(fitted.residual, fitted.reference, amps) == pytest.approx(grid, rel=1e-6)
+    assert fitting.acceptance_error(fitted.dense_residual, fitted.dense_reference, amps) == pytest.approx(
+        dense, rel=1e-6
+    )
+    assert fitted.error(amps) == pytest.approx(max(grid, dense), rel=1e-6)
+
+
+def test_sharp_eevee_lobes_are_reported_as_the_dense_grid_sees_them(tmp_path):
+    """A sharp Gaussian facet term of the randomised set (slope 0.078): on
+    the acceptance grid's 180 points EEVEE's fit looks twice as good as it
+    renders between them; the reported error is the dense grid's."""
+    from lut import eevee
+
+    paint = dict(bench.random_paints())["#23 gau 0.0779 g +0.43"]
+    table = baking.load_lut(baking.bake(paint, tmp_path))
+    fitted = fitting.fit_lut(table, "EEVEE", calibration=(5, 0))
+    amps = table.amplitudes(paint)
+    grid = fitting.acceptance_error(fitted.residual, fitted.reference, amps)
+    evaluate = functools.partial(eevee.evaluate, version=(5, 0))
+    dense = _direct_error(fitted, table, paint, fitting.dense_points(), evaluate)
+    assert dense > 1.5 * grid
+    assert fitted.error(amps) == pytest.approx(dense, rel=1e-6)
+    back = fitting.read_fit(fitting.write_fit(fitted, tmp_path / "w.exr"))
+    assert back.error(amps) == pytest.approx(fitted.error(amps), rel=1e-9)
 
 
 def test_nearest_column_of_the_weights_texture_renders_the_reported_error(luts):
@@ -167,7 +202,7 @@ def test_nearest_column_of_the_weights_texture_renders_the_reported_error(luts):
         got += closure.evaluate(tl, tv, ph)[:, None] * (fitted.weights[k][:, j, 0].T @ amps.T)
     wt = np.cos(tl)[:, None]
     nearest = np.sqrt(np.sum(((got - ref) * wt) ** 2) / np.sum((ref * wt) ** 2))
-    assert nearest == pytest.approx(fitted.error(amps), abs=0.002)
+    assert nearest == pytest.approx(fitting.acceptance_error(fitted.residual, fitted.reference, amps), abs=0.002)
     views = fitted.weights[:, :, :: fitting.VIEW_SUBDIVISION]
     assert views.shape[2] == fitting.VIEWS
     between = fitting.resample_views(views, fitting.view_cosines(), fitted.cos_view)

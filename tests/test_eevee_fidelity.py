@@ -73,11 +73,16 @@ def test_eevee_renders_the_randomised_set_as_measured(randomised):
     reflection lobes; the viewport's Material Preview and a final EEVEE
     render are the same engine) against the model: bounds a little above
     what this set measures on Blender 5.0 and 5.2 (README), so a broken
-    calibration or fit shows.  Smooth paints: the median within 4%; rough:
-    the median within 15%; none beyond 45%."""
+    calibration, fit or texture lookup shows.  Smooth paints: the median
+    within 3%; rough: the median within 10%; none beyond 30%.  And the error
+    the fit reports (the panel's) is not far below the render's: within
+    1.6 times it plus 2% (on the acceptance grid alone, sharp lobes read
+    as a quarter of their rendered error)."""
     smooth = [r["eevee"] for r in randomised if r["paint"].slope == 0]
     rough = [r["eevee"] for r in randomised if r["paint"].slope > 0]
     assert len(smooth) >= 3 and len(rough) >= 9
-    assert np.median(smooth) <= 0.04
-    assert np.median(rough) <= 0.15
-    assert max(smooth + rough) <= 0.45
+    assert np.median(smooth) <= 0.03
+    assert np.median(rough) <= 0.10
+    assert max(smooth + rough) <= 0.30
+    for row in randomised:
+        assert row["eevee"] <= 1.6 * row["eevee_fit"] + 0.02, row["label"]
