@@ -1,0 +1,116 @@
+"""Fit fidelity on randomised sets without Blender: the error each engine's
+closure fit reports for a paint (the panel's figure; Cycles renders land
+within 0.5% of it), per paint and as worst and median.
+
+    .venv/bin/python scripts/fit_fidelity.py [--set dark|random] [--count 24] [--seed N]
+    .venv/bin/python scripts/fit_fidelity.py --limits
+
+``--set random`` is the acceptance set of ``lut.bench.random_paints``;
+``--set dark`` the dark, facet-dominated rough paints of
+``lut.bench.dark_paints``.  Cycles is fitted as Blender 5 renders it
+(exact dielectric Metallic lobes) and as Blender 4.2-4.5 do (GGX lobes);
+EEVEE against Blender 5.0's measured closure responses."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+import sys
+import tempfile
+
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+if str(ROOT) not in sys.path:
+    sys.path.insert(0, str(ROOT))
+
+from lut import bench, files, fitting, render  # noqa: E402
+
+SETS = {"random": bench.random_paints, "dark": bench.dark_paints}
+
+#: Black-pigment paints (facet term alone but for a trace of diffuse) for
+#: ``--limits``: how far more closures take the Cycles fit of a facet term.
+LIMIT_TYPES = (("gaussian", 1.0), ("gaussian", 2.0), ("exponential", 2.0), ("exponential", 3.0))
+
+
+def limits(directory, budgets=(8, 12, 40)):
+    """[(distribution, slope, {budget: Cycles error})] of ``LIMIT_TYPES`` on
+    ρ = 0.02, no single scattering, surface reflection 1."""
+    from lut import baking
+    from lut.paint import Paint
+
+    rows = []
+    for distribution, slope in LIMIT_TYPES:
+        paint = Paint(rho=0.02, single=0.0, slope=slope, distribution=distribution, facet=1.0)
+        table = baking.load_lut(baking.bake(paint, directory))
+        amps = table.amplitudes(paint)
+        errors = {b: fitting.fit_lut(table, "CYCLES", budget=b, extra_budget=0).error(amps) for b in budgets}
+        rows.append((distribution, slope, errors))
+    return rows
+
+
+def measure(paints, directory):
+    """[(label, paint, {"CYCLES", "CYCLES 4.x", "EEVEE": reported error})]."""
+    rows = []
+    for label, paint in paints:
+        errors = render.bake_for_render(paint, directory, eevee_calibration=(5, 0)).errors(paint)
+        errors["CYCLES 4.x"] = render.bake_for_render(
+            paint, directory, targets=("CYCLES",), exact_metallic=False
+        ).errors(paint)["CYCLES"]
+        rows.append((label, paint, errors))
+    return rows
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--set", choices=sorted(SETS), default="dark")
+    parser.add_argument("--count", type=int, default=24)
+    parser.add_argument("--seed", type=int, help="the set's seed (default: the set's own)")
+    parser.add_argument("--out", type=pathlib.Path, help="write the figures to this JSON file")
+    parser.add_argument(
+        "--limits", action="store_true", help="instead: black-pigment facet terms fitted with 8, 12 and 40 closures"
+    )
+    args = parser.parse_args(argv)
+    if args.limits:
+        with tempfile.TemporaryDirectory() as tmp:
+            for distribution, slope, errors in limits(pathlib.Path(tmp)):
+                shown = ", ".join(f"{b} closures {e:.2%}" for b, e in errors.items())
+                print(f"{distribution} slope {slope:g}, rho 0.02: {shown}", flush=True)
+        return 0
+    kwargs = {} if args.seed is None else {"seed": args.seed}
+    paints = SETS[args.set](args.count, **kwargs)
+    with tempfile.TemporaryDirectory() as tmp:
+        rows = measure(paints, pathlib.Path(tmp))
+    keys = ("CYCLES", "CYCLES 4.x", "EEVEE")
+    print("| paint | " + " | ".join(keys) + " |")
+    print("|---" * (len(keys) + 1) + "|")
+    for label, _, errors in rows:
+        print(f"| {label} | " + " | ".join(f"{errors[k]:.2%}" for k in keys) + " |")
+    report = {"set": args.set, "paints": {label: errors for label, _, errors in rows}, "summary": {}}
+    for name, rough in (("smooth", False), ("rough", True)):
+        chosen = [(p, e) for _, p, e in rows if (p.slope > 0) == rough]
+        if not chosen:
+            continue
+        for key in keys:
+            target = fitting.TARGET_ERROR["EEVEE" if key == "EEVEE" else "CYCLES"][name]
+            values = np.array([e[key] for _, e in chosen])
+            misses = [f"{p.distribution[:3]} {p.slope:g}" for p, e in chosen if e[key] > target]
+            report["summary"][f"{key} {name}"] = {
+                "worst": float(values.max()),
+                "median": float(np.median(values)),
+                "within": int(len(values) - len(misses)),
+                "count": len(values),
+            }
+            missed = f" (misses: {', '.join(misses)})" if misses else ""
+            print(
+                f"{key:10s} {name:6s} n={len(values):2d} worst {values.max():.2%} median {np.median(values):.2%};"
+                f" {len(values) - len(misses)} within {target:.0%}{missed}"
+            )
+    if args.out:
+        files.atomic_write_text(args.out, json.dumps(report, indent=2) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
