@@ -37,6 +37,8 @@ TERMS = [
     (Closure("metallic", ior=1.5, roughness=0.2), 0.6),
     (Closure("lambert"), 0.25),
     (Closure("metallic", ior=1.5, roughness=0.9), 0.8),
+    (Closure("retro_glossy", roughness=0.8), 0.4),
+    (Closure("metallic", ior=1.5, roughness=0.0), 0.9),
 ]
 #: The sums measured: indices into ``TERMS``.  Prefixes of TERMS, and pairs
 #: and triples that tell which closures EEVEE keeps apart.
@@ -60,6 +62,7 @@ CASES = {
     "4 reflection": [3, 4, 2, 5],
     "Lambert + 3 reflection": [0, 3, 4, 2],
     "2 Lambert + 2 reflection": [0, 6, 3, 2],
+    "Lambert + retro glossy + mirror": [0, 8, 9],
 }
 GAMMAS = (0.0, 30.0, 60.0)
 
