@@ -108,10 +108,7 @@ def store_result(material, paint: lut.Paint, result: render.RenderBake, exact_me
     settings.internal_reflectance = result.lut.internal_reflectance
     settings.diffuse_albedo = render.diffuse_albedo(result.lut)
     nodes.build_seen_group(result.fits[next(iter(result.fits))], settings.diffuse_albedo)
-    settings.fits = json.dumps(
-        {target: {"residual": f.residual.tolist(), "reference": f.reference.tolist(), "goal": f.target_error}
-         for target, f in result.fits.items()}
-    )  # fmt: skip
+    settings.fits = json.dumps({target: {**f.grams(), "goal": f.target_error} for target, f in result.fits.items()})
     export.update_fallback(material, paint)
     if clear_stale:
         settings.stale = False
@@ -182,8 +179,9 @@ def _loaded_lut(path):
 
 def fit_errors(material) -> dict:
     """{engine: (error, target)} of the material's current colours against
-    its bake's fits (cos-weighted relative RMS on the acceptance grid); empty
-    before a bake."""
+    its bake's fits (``lut.fitting.reported_error``: cos-weighted relative
+    RMS on the acceptance grid and a dense grid, the larger); empty before a
+    bake."""
     settings = material.paint_lut
     if not settings.fits or settings.internal_reflectance <= 0:
         return {}
@@ -195,10 +193,7 @@ def fit_errors(material) -> dict:
     amps = render.amplitudes_of_inputs(
         render.node_inputs(paint, settings.internal_reflectance), settings.internal_reflectance
     )
-    return {
-        target: (lut.fitting.acceptance_error(f["residual"], f["reference"], amps), float(f["goal"]))
-        for target, f in fits.items()
-    }
+    return {target: (lut.fitting.reported_error(f, amps), float(f["goal"])) for target, f in fits.items()}
 
 
 def set_paint(material, paint: lut.Paint) -> None:

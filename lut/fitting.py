@@ -178,10 +178,16 @@ class Fit:
         values on the acceptance grid and on ``DENSE_GRID``, so neither a
         grid point nor a lobe between the grid's points is seen better
         than it renders."""
-        grid = acceptance_error(self.residual, self.reference, amplitudes)
-        if self.dense_residual is None:
-            return grid
-        return max(grid, acceptance_error(self.dense_residual, self.dense_reference, amplitudes))
+        return reported_error(self.grams(), amplitudes)
+
+    def grams(self) -> dict:
+        """The Gram matrices the reported error comes from, as lists (what a
+        material stores to show its error for any colour): residual,
+        reference and, where present, dense_residual, dense_reference."""
+        out = {"residual": self.residual.tolist(), "reference": self.reference.tolist()}
+        if self.dense_residual is not None:
+            out.update(dense_residual=self.dense_residual.tolist(), dense_reference=self.dense_reference.tolist())
+        return out
 
     def header(self) -> dict:
         return {
@@ -213,6 +219,16 @@ def component_errors(residual, reference) -> dict:
         ref = reference[:, c, c].sum()
         out[name] = float(np.sqrt(residual[:, c, c].sum() / ref)) if ref > 0 else None
     return out
+
+
+def reported_error(grams: dict, amplitudes) -> float:
+    """The error a fit reports for a colour (``Fit.error``) from its Gram
+    matrices (``Fit.grams``): the larger of the acceptance grid's and the
+    dense grid's (where the grams have it)."""
+    grid = acceptance_error(grams["residual"], grams["reference"], amplitudes)
+    if grams.get("dense_residual") is None:
+        return grid
+    return max(grid, acceptance_error(grams["dense_residual"], grams["dense_reference"], amplitudes))
 
 
 def acceptance_error(residual, reference, amplitudes) -> float:
