@@ -1,8 +1,8 @@
 """Removing the files no material uses any more from a LUT directory.
 
 ``clean(directory, keep)`` removes the LUT files (``paintlut-<key>.exr``)
-not in ``keep``, the closure weights files (``paintfit-<target>-<key>.exr``,
-e.g. ``paintfit-cycles-…``, ``paintfit-eevee-…``) of the LUTs it removes or that have no LUT
+not in ``keep``, the closure weights files (``paintfit-<target>[-f<version>]-<key>.exr``,
+e.g. ``paintfit-cycles-f6-…``, ``paintfit-eevee-…``) of the LUTs it removes or that have no LUT
 kept, and the temporary files that interrupted writes left behind.  Nothing
 else in the directory is touched, and nothing outside it."""
 
@@ -14,7 +14,7 @@ import re
 from . import files
 
 _LUT = re.compile(r"^paintlut-(?P<key>[0-9a-f]{8,64})\.exr$")
-_WEIGHTS = re.compile(r"^paintfit-(?:[a-z0-9]+-)?(?P<key>[0-9a-f]{8,64})\.exr$")
+_WEIGHTS = re.compile(r"^paintfit-(?:[a-z0-9]+-)*(?P<key>[0-9a-f]{8,64})\.exr$")
 
 
 def _key(path) -> str | None:

@@ -29,14 +29,16 @@ The fit, per render target (``fit_lut``):
    factor clamps there).
 3. Weights.  Non-negative least squares per view and component over the
    chosen closures (``lut.nnls``).
-4. Error.  On the acceptance grid (θl, θv <= 75°, azimuths off the mirror):
-   the closures with their weights interpolated in cos θv as Blender's
-   texture lookup does, against the LUT.  Stored as Gram matrices of the
-   residuals and targets per component, so the cos-weighted relative RMS of
-   any colour is ``Fit.error(amplitudes)``: the panel shows it live.
+4. Error.  On the acceptance grid (θl, θv <= 75°, azimuths off the mirror)
+   and on a dense grid of the same range (``DENSE_GRID``): the closures
+   with their weights interpolated linearly in cos θv, against the LUT.
+   Stored as Gram matrices of the residuals and targets per component, so
+   the cos-weighted relative RMS of any colour, the larger of the two
+   grids', is ``Fit.error(amplitudes)``: the panel shows it live.
 
 The weights file (``write_fit``) is a Non-Color float EXR with one row per
-(closure, component) pair in use and one column per view cosine, plus a
+(closure, component) pair in use and ``TEXTURE_VIEWS`` columns (the fitted
+views' weights, linear between them, read by the nearest column), plus a
 header with everything a node group is built from, so a fit read back
 renders identically."""
 
@@ -56,7 +58,9 @@ from .nnls import nnls_gram_batch
 from .paint import COMPONENTS, reference_index
 
 #: Fit format version: bumped when the weights file layout or the fit changes.
-FIT_VERSION = 5
+#: It is part of the weights file's name (``fit_path``), so a new release
+#: never overwrites a file that an older release's node groups still read.
+FIT_VERSION = 6
 
 #: The acceptance measure's geometries: θl, θv <= 75° and azimuths away from
 #: the exact mirror direction (φ = 0); the Cycles oracle tests use the same.
@@ -257,6 +261,14 @@ def texture_views(views=VIEWS) -> int:
     """Columns of the weights texture for weights fitted at ``views`` views
     (``TEXTURE_VIEWS`` for the default): ``VIEW_SUBDIVISION`` per interval."""
     return VIEW_SUBDIVISION * (int(views) - 1) + 1
+
+
+def texture_u(views):
+    """(scale, offset) of the weights texture's lookup u = scale·cos θv +
+    offset: column j, centred at u = (j + 0.5)/M, holds cos θv = j/(M - 1),
+    so the texel under u (Closest interpolation) is the column nearest to
+    cos θv."""
+    return (views - 1) / views, 0.5 / views
 
 
 def resample_views(weights, cos_view, dense):
@@ -583,15 +595,15 @@ def fit_lut(
 
 
 def fit_path(lut_path, target="CYCLES", exact_metallic=True, calibration=None) -> pathlib.Path:
-    """The weights file of a target beside its LUT: ``paintfit-cycles-<key>.exr``
-    (``paintfit-cycles4-…`` for Blender 4.2-4.5's lobes), ``paintfit-eevee-…``
-    (``paintfit-eevee50-…`` when fitted with Blender 5.0's measured EEVEE
-    responses)."""
+    """The weights file of a target beside its LUT:
+    ``paintfit-cycles-f<FIT_VERSION>-<key>.exr`` (``paintfit-cycles4-…`` for
+    Blender 4.2-4.5's lobes), ``paintfit-eevee-…`` (``paintfit-eevee50-…``
+    when fitted with Blender 5.0's measured EEVEE responses)."""
     lut_path = pathlib.Path(lut_path)
     name = closures.validate_target(target).lower() + ("" if exact_metallic else "4")
     if target == "EEVEE" and calibration is not None:
         name += "".join(str(int(v)) for v in calibration[:2])
-    return lut_path.with_name(lut_path.name.replace("paintlut-", f"paintfit-{name}-"))
+    return lut_path.with_name(lut_path.name.replace("paintlut-", f"paintfit-{name}-f{FIT_VERSION}-"))
 
 
 def _image(fitted: Fit) -> np.ndarray:

@@ -263,7 +263,7 @@ def test_clean_removes_only_luts_and_weights_nothing_keeps(tmp_path, capsys):
     kept = lut.bake(lut.Paint(rho=0.2), tmp_path, resolution=(8, 6, 4))
     gone = lut.bake(lut.Paint(n=1.6, rho=0.7), tmp_path, resolution=(8, 6, 4))  # another paint type
     for path in (kept, gone):
-        for prefix in ("paintfit-cycles-", "paintfit-eevee-"):
+        for prefix in ("paintfit-cycles-", "paintfit-eevee50-f6-"):
             path.with_name(path.name.replace("paintlut-", prefix)).write_bytes(b"weights")
     other = tmp_path / "notes.exr"
     other.write_bytes(b"x")
@@ -278,7 +278,7 @@ def test_clean_removes_only_luts_and_weights_nothing_keeps(tmp_path, capsys):
     assert main(["clean", str(tmp_path), "--keep", str(kept)]) == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
         [kept.name, "notes.exr", kept.name.replace("paintlut-", "paintfit-cycles-"),
-         kept.name.replace("paintlut-", "paintfit-eevee-")]
+         kept.name.replace("paintlut-", "paintfit-eevee50-f6-")]
     )  # fmt: skip
     assert "removed 4 file(s)" in capsys.readouterr().out
     with pytest.raises(ValueError, match="not a LUT"):
