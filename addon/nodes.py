@@ -239,8 +239,7 @@ def _view_lookup(tree, links, lay, views):
     to_u.use_clamp = True
     to_u.label = "texture u"
     links.new(dot.outputs["Value"], to_u.inputs[0])
-    to_u.inputs[1].default_value = (views - 1) / views
-    to_u.inputs[2].default_value = 0.5 / views
+    to_u.inputs[1].default_value, to_u.inputs[2].default_value = fitting.texture_u(views)
     return to_u.outputs[0]
 
 

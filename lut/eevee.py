@@ -86,12 +86,9 @@ def reference(closure: Closure, theta_l, theta_v, phi):
     if kind in ("lambert", "oren_nayar", "sheen"):
         return np.where(theta_l < np.pi / 2, np.cos(theta_l), 0.0) / np.pi
     if kind == "retro_toon":
-        cos_lv = -np.sin(theta_l) * np.sin(theta_v) * np.cos(phi) + np.cos(theta_l) * np.cos(theta_v)
-        return np.maximum(cos_lv, 0.0) / np.pi
-    if kind == "retro_glossy":
-        gamma = light_view_angle(theta_l, theta_v, phi)
-        zero = np.zeros_like(gamma)
-        return np.where(theta_l < np.pi / 2, ggx_lobe(gamma, zero, zero, closure.roughness)[0], 0.0)
+        return np.maximum(np.cos(light_view_angle(theta_l, theta_v, phi)), 0.0) / np.pi
+    if kind == "retro_glossy":  # its Cycles formula is the GGX lobe about the view
+        return closure.evaluate(theta_l, theta_v, phi)
     if kind in ("glossy", "metallic"):
         lobe, cos_d = ggx_lobe(theta_l, theta_v, phi, closure.roughness)
         if kind == "glossy":

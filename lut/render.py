@@ -39,8 +39,9 @@ class RenderBake:
         return self.lut.key
 
     def errors(self, paint: Paint) -> dict:
-        """{target: cos-weighted relative RMS of this paint's render on the
-        acceptance grid}."""
+        """{target: the error each fit reports for this paint (``Fit.error``:
+        cos-weighted relative RMS on the acceptance and dense grids, the
+        larger)}."""
         amps = self.lut.amplitudes(paint)
         return {target: fit.error(amps) for target, fit in self.fits.items()}
 

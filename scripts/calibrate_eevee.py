@@ -17,7 +17,9 @@ and lobes of any roughness keep their analytic shape between cells.
 Run ``python scripts/calibrate_eevee.py`` with a Python whose ``bpy`` renders
 EEVEE; the tables of that Blender line (``bpy.app.version[:2]``) are added to
 the file, those of other lines kept (``--only KIND ...``: only those kinds
-are measured, and added to the line's other tables)."""
+are measured, and added to the line's other tables).  New tables change
+what EEVEE fits are made from: bump ``lut.fitting.FIT_VERSION`` with them,
+so cached fits are made again."""
 
 from __future__ import annotations
 
@@ -190,7 +192,7 @@ class SphereScene:
 
     def surface_normals(self):
         """The spheres' shading normals (H, W, 3), rendered once with every
-        material replaced by a Diffuse BSDF: the Normal pass of a material
+        material replaced by a new material's default: the Normal pass of a material
         reports its closures' normals, which for a lobe about the view
         direction (``retro_toon``, ``retro_glossy``) is not the surface's."""
         if self._normal is None:
@@ -328,7 +330,11 @@ def main(argv=None):
     parser.add_argument("--raw", type=pathlib.Path, help="also keep the pixels' samples in this .npz")
     parser.add_argument("--from-raw", type=pathlib.Path, help="make the tables from samples kept by --raw")
     parser.add_argument(
-        "--only", nargs="+", metavar="KIND", help="measure only these closure kinds, keeping the line's other tables"
+        "--only",
+        nargs="+",
+        choices=eevee.KINDS,
+        metavar="KIND",
+        help="measure only these closure kinds, keeping the line's other tables",
     )
     args = parser.parse_args(argv)
     todo = [c for c in calibration_closures() if not args.only or c.kind in args.only]

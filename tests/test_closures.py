@@ -106,6 +106,22 @@ def test_candidates_per_target():
     assert "retro_glossy" not in {c.kind for c in closures.candidates(smooth)}
 
 
+def test_eevee_fits_keep_to_two_reflection_closures_with_the_mirror(tmp_path):
+    """EEVEE sums two reflection closures exactly: a smooth type's mirror is
+    one, so its fit takes at most one more (a retro lobe, for a
+    back-scattering pigment); a rough type's fit at most two lobes."""
+    from lut import eevee
+
+    smooth = baking.load_lut(baking.bake(lut.Paint(rho=0.03, single=0.2, g=-0.5), tmp_path))
+    rough = baking.load_lut(baking.bake(lut.Paint(rho=0.03, single=0.2, g=-0.5, slope=0.2), tmp_path))
+    smooth_fit = fitting.fit_lut(smooth, "EEVEE", calibration=(5, 0))
+    assert smooth_fit.mirror
+    assert [c.kind for c in smooth_fit.closures if eevee.is_reflection(c)] == ["retro_glossy"]
+    rough_fit = fitting.fit_lut(rough, "EEVEE", calibration=(5, 0))
+    assert 1 <= sum(eevee.is_reflection(c) for c in rough_fit.closures) <= eevee.EXACT_REFLECTION_CLOSURES
+    assert "retro_glossy" not in {c.kind for c in rough_fit.closures}
+
+
 def test_retro_glossy_is_a_ggx_lobe_about_the_view():
     """Its value depends on the light-view angle alone (the lobe's frame is
     the view direction), peaks with the light at the viewer, and is the GGX
@@ -203,6 +219,11 @@ def test_nearest_column_of_the_weights_texture_renders_the_reported_error(luts):
     wt = np.cos(tl)[:, None]
     nearest = np.sqrt(np.sum(((got - ref) * wt) ** 2) / np.sum((ref * wt) ** 2))
     assert nearest == pytest.approx(fitting.acceptance_error(fitted.residual, fitted.reference, amps), abs=0.002)
+    # The node group's lookup coordinate puts the texel of that column under every cos θv.
+    scale, offset = fitting.texture_u(len(fitted.cos_view))
+    cos = np.linspace(0.0, 1.0, 100_001)
+    texel = np.minimum(np.floor((scale * cos + offset) * len(fitted.cos_view)), len(fitted.cos_view) - 1)
+    np.testing.assert_array_equal(texel, np.rint(cos * (len(fitted.cos_view) - 1)))
     views = fitted.weights[:, :, :: fitting.VIEW_SUBDIVISION]
     assert views.shape[2] == fitting.VIEWS
     between = fitting.resample_views(views, fitting.view_cosines(), fitted.cos_view)
