@@ -2,6 +2,7 @@
 for the running Blender line (the README's EEVEE column).
 
     .venv/bin/python scripts/eevee_fidelity.py [--random 24] [--seed 2026] [--out FILE.json]
+    .venv/bin/python scripts/eevee_fidelity.py --named   # the presets and named paints
     .venv-bpy52/bin/python scripts/eevee_fidelity.py      # Blender 5.2 LTS
 
 Method.  Every paint of ``lut.bench.random_paints`` is made a material by the
@@ -14,8 +15,8 @@ every sphere's pixels a spread of (θl, θv, φ) (from the Normal pass), so one
 sweep measures every paint at once.  Each paint's pixels are compared with
 ``Paint.brdf``·cos θl by ``lut.bench.binned_error``: the acceptance measure
 (cos-weighted relative RMS, θl, θv <= 75°, away from the mirror direction)
-on 5° × 5° × 15° bins.  Printed beside it: the error the EEVEE fit predicts
-on the acceptance grid (what the panel shows).  And, for the viewport
+on 5° × 5° × 15° bins.  Printed beside it: the error the EEVEE fit reports
+(``Fit.error``, on the acceptance and dense grids: what the panel shows).  And, for the viewport
 against the final render, the same pixels against Cycles' render of the
 same materials (``--cycles``)."""
 
@@ -127,8 +128,18 @@ def main(argv=None) -> int:
     parser.add_argument("--cycles", action="store_true", help="also render the spheres in Cycles: EEVEE vs Cycles")
     parser.add_argument("--out", type=pathlib.Path, default=default_out)
     parser.add_argument("--luts", type=pathlib.Path, help="bake into (and reuse) this folder, not a temporary one")
+    parser.add_argument(
+        "--named", action="store_true", help="the named paints (addon.scenes.paints) instead of the randomised set"
+    )
     args = parser.parse_args(argv)
-    paints = bench.random_paints(args.random, args.seed)
+    if args.named:
+        from addon.scenes import paints as named
+
+        paints = list(named().items())
+        if args.out == default_out:
+            args.out = default_out.with_name(f"eevee_fidelity-named-{version}.json")
+    else:
+        paints = bench.random_paints(args.random, args.seed)
     import addon
 
     addon.register()

@@ -1,6 +1,6 @@
 """Fit fidelity on randomised sets without Blender: the error each engine's
 closure fit reports for a paint (the panel's figure; Cycles renders land
-within 0.5% of it), per paint and as worst and median.
+within 0.5% of it plus a tenth), per paint and as worst and median.
 
     .venv/bin/python scripts/fit_fidelity.py [--set dark|random] [--count 24] [--seed N]
     .venv/bin/python scripts/fit_fidelity.py --limits
