@@ -187,11 +187,14 @@ class Fit:
     def grams(self) -> dict:
         """The Gram matrices the reported error comes from, as lists (what a
         material stores to show its error for any colour): residual,
-        reference and, where present, dense_residual, dense_reference."""
-        out = {"residual": self.residual.tolist(), "reference": self.reference.tolist()}
-        if self.dense_residual is not None:
-            out.update(dense_residual=self.dense_residual.tolist(), dense_reference=self.dense_reference.tolist())
-        return out
+        reference, dense_residual and dense_reference (None without them)."""
+        dense = self.dense_residual is not None
+        return {
+            "residual": self.residual.tolist(),
+            "reference": self.reference.tolist(),
+            "dense_residual": self.dense_residual.tolist() if dense else None,
+            "dense_reference": self.dense_reference.tolist() if dense else None,
+        }
 
     def header(self) -> dict:
         return {
@@ -206,10 +209,7 @@ class Fit:
             "mirror": self.mirror,
             "n": self.n,
             "internal_reflectance": self.internal_reflectance,
-            "residual": self.residual.tolist(),
-            "reference": self.reference.tolist(),
-            "dense_residual": None if self.dense_residual is None else self.dense_residual.tolist(),
-            "dense_reference": None if self.dense_reference is None else self.dense_reference.tolist(),
+            **self.grams(),
             "lut_key": self.lut_key,
             "calibration": list(self.calibration) if self.calibration else None,
         }
@@ -273,7 +273,8 @@ def texture_u(views):
 
 def resample_views(weights, cos_view, dense):
     """Weights (K, C, M, T) at view cosines ``cos_view``, linearly
-    interpolated onto the view cosines ``dense`` (K, C, len(dense), T)."""
+    interpolated at the view cosines ``dense`` (K, C, len(dense), T): the
+    texture's columns, or the views of points where the fit is measured."""
     k_, c_, _, t_ = weights.shape
     out = np.empty((k_, c_, len(dense), t_))
     for k in range(k_):
@@ -447,13 +448,7 @@ def _acceptance_grams(lut, basis, cos_view, weights, evaluate, grid=ACCEPTANCE_G
     cos_l = np.cos(tl)
     target = lut.components(tl, tv, ph) * cos_l[:, None, None]  # (N, T, C)
     values = np.array([evaluate(c, tl, tv, ph) for c in basis]).reshape(len(basis), tl.size)  # (K, N); K may be 0
-    k_, c_, m_, t_ = weights.shape
-    w = np.empty((k_, c_, tl.size, t_))
-    for k in range(k_):
-        for c in range(c_):
-            for t in range(t_):
-                w[k, c, :, t] = np.interp(np.cos(tv), cos_view, weights[k, c, :, t])
-    fitted = np.einsum("kn,kcnt->ntc", values, w)
+    fitted = np.einsum("kn,kcnt->ntc", values, resample_views(weights, cos_view, np.cos(tv)))
     r = (fitted - target) * cos_l[:, None, None]
     ref = target * cos_l[:, None, None]
     return np.einsum("ntc,ntd->tcd", r, r), np.einsum("ntc,ntd->tcd", ref, ref)
@@ -525,7 +520,8 @@ def fit_lut(
     allowed = np.array([[not grey[k] or p % c_ == facet for k in range(len(basis))] for p in range(t_ * c_)])
     upper = np.array([c.max_weight for c in basis])
     cost = np.array([c.cost for c in basis])
-    target_error = TARGET_ERROR[target]["rough" if float(type_dict["slope"]) > 0 else "smooth"]
+    mirror = float(type_dict["slope"]) == 0.0  # a smooth interface: its mirror is a closure of its own
+    target_error = TARGET_ERROR[target]["smooth" if mirror else "rough"]
     goal = 0.25 * target_error
     caps = None
     if target == "EEVEE":
@@ -534,7 +530,6 @@ def fit_lut(
         # EEVEE sums one diffuse normal and two reflection closures exactly
         # per pixel; beyond that it picks closures at random (noise).  A
         # smooth type's mirror is one of the two.
-        mirror = float(type_dict["slope"]) == 0.0
         caps = (np.array([eevee.is_reflection(c) for c in basis]), eevee.EXACT_REFLECTION_CLOSURES - mirror)
 
     def weights_of(chosen):
@@ -581,7 +576,7 @@ def fit_lut(
         weights=resample_views(weights, cos_view, dense),
         residual=residual,
         reference=reference,
-        mirror=float(type_dict["slope"]) == 0.0,
+        mirror=mirror,
         n=n,
         internal_reflectance=lut.internal_reflectance,
         lut_key=lut.key,
