@@ -1,7 +1,7 @@
 """Headless API of the add-on (for scripts and farms): no UI involved.
 
 A material's paint is a paint *type* (n, g, slope, distribution) baked once
-into a LUT and fitted for every render engine (``lut.render``), and colours
+into a LUT and fitted for every render engine (``lut.render.bake``), and colours
 that are node-group inputs: ``bake_material`` bakes (or reuses) the type and
 wires the groups; ``update_inputs`` sends the colours to the groups, which
 is all a colour edit needs."""
@@ -9,15 +9,14 @@ is all a colour edit needs."""
 from __future__ import annotations
 
 import dataclasses
-import functools
 import json
 import pathlib
 
 import bpy
 
 from . import export, nodes, properties, validation
-from ._lut import closures, eevee, lut, render
-from .properties import working_space
+from ._lut import closures, eevee, lut, render_bake
+from .live import _loaded_lut, paint_of, update_inputs, working_space  # noqa: F401  (the API's names)
 
 #: LUTs go here, relative to the saved .blend file.
 LUT_DIRECTORY = "//paint_lut"
@@ -40,11 +39,6 @@ def lut_directory() -> pathlib.Path:
         folder = pathlib.Path(tempfile.gettempdir()) / f"paint_lut-{getpass.getuser()}"
         folder.mkdir(parents=True, exist_ok=True)
         return folder
-
-
-def paint_of(material) -> lut.Paint:
-    """The lut.Paint of a material's Paint LUT settings, in the scene's working space."""
-    return material.paint_lut.to_paint(working_space())
 
 
 @dataclasses.dataclass(frozen=True)
@@ -88,12 +82,12 @@ def engine_targets():
 
 def eevee_calibration():
     """The Blender line whose measured EEVEE closure responses the EEVEE fit
-    uses (``lut.eevee``): this Blender's, or None where EEVEE is not
+    uses (``lut.render.eevee``): this Blender's, or None where EEVEE is not
     calibrated (Blender 4.x)."""
     return eevee.calibration_for(bpy.app.version)
 
 
-def store_result(material, paint: lut.Paint, result: render.RenderBake, exact_metallic=None, clear_stale=True):
+def store_result(material, paint: lut.Paint, result: render_bake.RenderBake, exact_metallic=None, clear_stale=True):
     """Record a finished bake on the material (LUT path relative to the
     .blend when it is saved), build or reuse its type's node groups (one per
     render engine), wire them, set the colour inputs and the fit errors, and
@@ -104,9 +98,9 @@ def store_result(material, paint: lut.Paint, result: render.RenderBake, exact_me
     groups = {
         target: nodes.build_group(fit, result.fit_paths[target], exact_metallic) for target, fit in result.fits.items()
     }
-    nodes.wire(material, groups, render.node_inputs(paint, result.lut.internal_reflectance))
+    nodes.wire(material, groups, render_bake.node_inputs(paint, result.lut.internal_reflectance))
     settings.internal_reflectance = result.lut.internal_reflectance
-    settings.diffuse_albedo = render.diffuse_albedo(result.lut)
+    settings.diffuse_albedo = render_bake.diffuse_albedo(result.lut)
     nodes.build_seen_group(result.fits[next(iter(result.fits))], settings.diffuse_albedo)
     settings.fits = json.dumps({target: {**f.grams(), "goal": f.target_error} for target, f in result.fits.items()})
     export.update_fallback(material, paint)
@@ -120,10 +114,10 @@ def bake_material(material, *, directory=None, force=False, exact_metallic=None,
     material's node tree.  ``directory``: where the files go (default
     ``lut_directory()``); ``exact_metallic``: whether Blender's Metallic BSDF
     is the exact dielectric lobe (default: this Blender's,
-    ``nodes.EXACT_METALLIC``).  Returns the ``lut.render.RenderBake``."""
+    ``nodes.EXACT_METALLIC``).  Returns the ``lut.render.bake.RenderBake``."""
     exact = nodes.exact_metallic_default(exact_metallic)
     paint = paint_of(material)
-    result = render.bake_for_render(
+    result = render_bake.bake_for_render(
         paint, directory or lut_directory(), targets=engine_targets(), exact_metallic=exact,
         eevee_calibration=eevee_calibration(), force=force, progress=progress, **options,
     )  # fmt: skip
@@ -145,41 +139,9 @@ def finish_background_bake(material, paint, result, type_key_at_start) -> bool:
     return current
 
 
-def update_inputs(material) -> None:
-    """Send a material's colours (pigment, single scattering, surface
-    reflection) to its paint groups' inputs: a colour edit needs no bake."""
-    settings = material.paint_lut
-    try:
-        paint = paint_of(material)
-    except ValueError:
-        return
-    rbar = settings.internal_reflectance if settings.internal_reflectance > 0 else None
-    values = render.node_inputs(paint, rbar)
-    nodes.set_inputs(material, values)
-    if rbar is not None and settings.lut_path and not settings.stale:
-        try:  # the export fallback follows the colour too (its shape waits for the next bake)
-            table = _loaded_lut(bpy.path.abspath(settings.lut_path))
-            export.recolour_fallback(material, table, render.amplitudes_of_inputs(values, rbar))
-        except lut.LUTError:
-            pass  # no LUT to refit from: the fallback keeps its colour until the next bake
-
-
-@functools.lru_cache(maxsize=8)
-def _loaded_lut_at(path, mtime_ns):
-    return lut.load_lut(path)
-
-
-def _loaded_lut(path):
-    """A LUT read once per file version (colour edits come in bursts)."""
-    try:
-        return _loaded_lut_at(str(path), pathlib.Path(path).stat().st_mtime_ns)
-    except OSError as exc:
-        raise lut.LUTError(f"{path}: {exc}") from None
-
-
 def fit_errors(material) -> dict:
     """{engine: (error, target)} of the material's current colours against
-    its bake's fits (``lut.fitting.reported_error``: cos-weighted relative
+    its bake's fits (``lut.render.fitting.reported_error``: cos-weighted relative
     RMS on the acceptance grid and a dense grid, the larger); empty before a
     bake."""
     settings = material.paint_lut
@@ -190,10 +152,10 @@ def fit_errors(material) -> dict:
         paint = paint_of(material)
     except ValueError:
         return {}
-    amps = render.amplitudes_of_inputs(
-        render.node_inputs(paint, settings.internal_reflectance), settings.internal_reflectance
+    amps = render_bake.amplitudes_of_inputs(
+        render_bake.node_inputs(paint, settings.internal_reflectance), settings.internal_reflectance
     )
-    return {target: (lut.fitting.reported_error(f, amps), float(f["goal"])) for target, f in fits.items()}
+    return {target: (lut.render.fitting.reported_error(f, amps), float(f["goal"])) for target, f in fits.items()}
 
 
 def set_paint(material, paint: lut.Paint) -> None:
@@ -336,8 +298,8 @@ def is_current(material, paint, *, directory=None, exact_metallic=None, **option
         if not path.stem.endswith(table.key[:24]):  # another type's LUT renamed onto this one's name
             return False
         for target in engine_targets():
-            fit_file = lut.fitting.fit_path(path, target, exact, eevee_calibration())
-            fitted = lut.fitting.read_fit(fit_file)
+            fit_file = lut.render.fitting.fit_path(path, target, exact, eevee_calibration())
+            fitted = lut.render.fitting.read_fit(fit_file)
             if fitted.lut_key != table.key or fitted.target != target:
                 return False
             node = nodes.group_of(material, target)

@@ -8,7 +8,7 @@ Material Output (setting the flag clears it on the others); Blender's
 renderers take, per engine, an output targeted at that engine, active or
 not, before one for all engines (``ntreeShaderOutputNode``).  So the
 fallback is a Principled BSDF, with the paint's fitted parameters
-(``lut.principled.fit_principled``), into the active Material Output,
+(``lut.render.principled.fit_principled``), into the active Material Output,
 targeted at all engines: exporters see it, and Cycles and EEVEE keep
 rendering the paint's groups from their own outputs (tested by renders).
 Before a material's first bake (no engine outputs yet) the fallback is also
@@ -42,7 +42,7 @@ def add_principled_fallback(material, params: principled.PrincipledParams, error
     the parameters (and ``error``, the fit's acceptance error) in the
     material's ``paint_lut_principled`` property.  Returns the BSDF node."""
     if not isinstance(params, principled.PrincipledParams):
-        raise TypeError(f"params must be a lut.principled.PrincipledParams, got {type(params).__name__}")
+        raise TypeError(f"params must be a lut.render.principled.PrincipledParams, got {type(params).__name__}")
     tree = _node_tree(material)
     nodes, links = tree.nodes, tree.links
     bsdf = nodes.get(NODE)
@@ -50,7 +50,7 @@ def add_principled_fallback(material, params: principled.PrincipledParams, error
         bsdf = nodes.new("ShaderNodeBsdfPrincipled")
         bsdf.name = bsdf.label = NODE
         bsdf.location = (0.0, 400.0)
-    bsdf.distribution = "GGX"  # the single-scatter GGX lut.principled models
+    bsdf.distribution = "GGX"  # the single-scatter GGX lut.render.principled models
     for name, value in params.node_inputs().items():
         bsdf.inputs[name].default_value = value
     output = nodes.get(OUTPUT)
@@ -80,14 +80,10 @@ def fallback_params(material):
     return principled.PrincipledParams(**record), error
 
 
-def update_fallback(material, paint=None):
+def update_fallback(material, paint):
     """Fit the Principled fallback to a material's paint (``paint``: a
-    lut.Paint; default the material's own settings) and add it: call after
-    each bake or colour edit.  Returns (PrincipledParams, acceptance error)."""
-    if paint is None:
-        from . import api
-
-        paint = api.paint_of(material)
+    lut.Paint, ``api.paint_of(material)`` for its own settings) and add it:
+    call after each bake.  Returns (PrincipledParams, acceptance error)."""
     try:
         params, error = principled.fit_principled(paint)
     except ValueError:

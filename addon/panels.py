@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import bpy
 
+from . import api
 from .properties import MATERIAL_FIELDS
 
 
@@ -16,7 +17,7 @@ def draw_settings(layout, material):
     col.use_property_decorate = False
     col.label(text="Colours (live: no bake)")
     col.prop(settings, "seen")
-    for spec in MATERIAL_FIELDS:  # the colours and weights (lut.schema)
+    for spec in MATERIAL_FIELDS:  # the colours and weights (lut.paint.schema)
         if not spec.shapes_type:
             col.prop(settings, spec.name)
     col.label(text="Paint type (bake)")
@@ -29,8 +30,6 @@ def draw_settings(layout, material):
         layout.label(text="Paint type changed since the last bake", icon="ERROR")
     elif settings.lut_path:
         layout.label(text=bpy.path.basename(settings.lut_path), icon="CHECKMARK")
-        from . import api
-
         for target, (error, goal) in api.fit_errors(material).items():
             icon = "CHECKMARK" if error <= goal else "ERROR"
             layout.label(text=f"{target.title()} fit error {100 * error:.1f}% (target {100 * goal:.0f}%)", icon=icon)

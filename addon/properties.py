@@ -1,7 +1,7 @@
 """The paint settings stored on every material: ``material.paint_lut``.
 
 A property for every ``lut.Paint`` field a material stores, made from its
-description in ``lut.schema.PAINT_FIELDS`` (name, limits, slider, tooltip,
+description in ``lut.paint.schema.PAINT_FIELDS`` (name, limits, slider, tooltip,
 default), plus the preset, the baked LUT's path and a stale flag.
 Choosing a preset fills the fields with the preset's values (its spectral
 colours shown as RGB in the scene's working space) and bakes use the
@@ -17,7 +17,9 @@ import json
 
 import bpy
 
+from . import live
 from ._lut import lut, schema
+from .live import working_space
 
 #: The paint fields a material stores (in ``lut.Paint``'s order).
 MATERIAL_FIELDS = tuple(spec for spec in schema.PAINT_FIELDS.values() if spec.on_material)
@@ -34,14 +36,6 @@ _applying_preset = False
 # does not declare this option.  It is checked on 5.0 only, so earlier
 # versions are not asked for it.
 _RELATIVE_PATH = {"PATH_SUPPORTS_BLEND_RELATIVE"} if bpy.app.version >= (5, 0, 0) else set()
-
-
-def working_space() -> str:
-    """The scene-linear working space of the open file, as a lut space name
-    (Blender 5.0: bpy.data.colorspace.working_space; earlier: Linear Rec.709)."""
-    colorspace = getattr(bpy.data, "colorspace", None)
-    name = getattr(colorspace, "working_space", "Linear Rec.709") if colorspace is not None else "Linear Rec.709"
-    return name if name in lut.colour_management.WORKING_SPACES else "Linear Rec.709"
 
 
 def _leave_preset(self):
@@ -67,9 +61,7 @@ def _colour_changed(self, context):
 def _send_colours(settings):
     material = settings.id_data
     if isinstance(material, bpy.types.Material):
-        from . import api
-
-        api.update_inputs(material)
+        live.update_inputs(material)
 
 
 def _preset_changed(self, context):
@@ -107,16 +99,16 @@ def set_fields(settings, paint: lut.Paint) -> None:
 
 @functools.lru_cache(maxsize=32)
 def _spectral_inputs(paint_json: str):
-    return lut.render.node_inputs(lut.Paint.from_dict(json.loads(paint_json)))
+    return lut.render.bake.node_inputs(lut.Paint.from_dict(json.loads(paint_json)))
 
 
 def node_inputs(paint: lut.Paint) -> dict:
-    """The group inputs of a paint (``lut.render.node_inputs``): for an RGB
+    """The group inputs of a paint (``lut.render.bake.node_inputs``): for an RGB
     paint its own colours; for a spectral one the RGB that renders it
     exactly (computed once per paint)."""
     if paint.spectral or paint.dispersive:
         return dict(_spectral_inputs(json.dumps(paint.to_dict(), sort_keys=True)))
-    return lut.render.node_inputs(paint, internal_reflectance=0.0)
+    return lut.render.bake.node_inputs(paint, internal_reflectance=0.0)
 
 
 def _exact(value):
@@ -138,12 +130,12 @@ def _seen_constants(settings):
 
 def _get_seen(self):
     albedo, rbar = _seen_constants(self)
-    return tuple(float(v) for v in lut.render.seen_of_pigment(tuple(self.rho), albedo, rbar))
+    return tuple(float(v) for v in lut.render.bake.seen_of_pigment(tuple(self.rho), albedo, rbar))
 
 
 def _set_seen(self, value):
     albedo, rbar = _seen_constants(self)
-    self.rho = tuple(float(v) for v in lut.render.pigment_of_seen(value, albedo, rbar))
+    self.rho = tuple(float(v) for v in lut.render.bake.pigment_of_seen(value, albedo, rbar))
 
 
 class PaintLUTSettings(bpy.types.PropertyGroup):

@@ -29,6 +29,7 @@ import bpy
 import numpy as np
 from mathutils import Vector
 
+from . import api
 from ._lut import lut
 
 #: The oracle's image size (pixels across); every pixel sees the same directions.
@@ -221,9 +222,7 @@ def relative_rms(oracle, paint, grid=GRID, best_scale=False) -> float:
 
 def paint_material(oracle, paint, directory, name="paint", **options):
     """A material on the plane rendering ``paint`` through the add-on (set
-    and baked in ``directory``); returns (material, lut.render.RenderBake)."""
-    from . import api
-
+    and baked in ``directory``); returns (material, lut.render.bake.RenderBake)."""
     material = oracle.material(name)
     api.set_paint(material, paint)
     result = api.bake_material(material, directory=directory, **options)
@@ -246,7 +245,7 @@ def principled(oracle, paint):
 
 
 def principled_params_material(oracle, params):
-    """A Principled BSDF (single-scatter GGX) with ``lut.principled``
+    """A Principled BSDF (single-scatter GGX) with ``lut.render.principled``
     parameters on the plane: the export fallback as Cycles renders it."""
     mat = oracle.material("fallback")
     nodes, links = mat.node_tree.nodes, mat.node_tree.links

@@ -1,7 +1,7 @@
 """Checks that a paint can be stored on a material exactly.
 
 A material stores an RGB paint in its panel fields (``properties``), whose
-limits (``lut.schema``: ``FieldSpec.material``, e.g. n in [1, 4], g within
+limits (``lut.paint.schema``: ``FieldSpec.material``, e.g. n in [1, 4], g within
 ±0.99) are narrower than ``lut.Paint``'s and whose colours are in the
 scene's working space: Blender would clamp a value beyond them, and the
 material would bake a different paint.  ``check_paint_fits`` refuses such a
@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import properties
+from . import live, properties
 from ._lut import lut, schema
 
 #: Colour conversion between working spaces is rounded at this level.
@@ -34,8 +34,8 @@ def check_paint_fits(paint: lut.Paint, space: str | None = None) -> None:
         raise ValueError(f"paint must be a lut.Paint, got {type(paint).__name__}")
     if _stored_whole(paint):
         return
-    space = space or properties.working_space()
-    matrix = lut.colour_management.rgb_to_rgb(paint.space, space) if space != paint.space else np.eye(3)
+    space = space or live.working_space()
+    matrix = lut.colour.management.rgb_to_rgb(paint.space, space) if space != paint.space else np.eye(3)
     for spec in properties.MATERIAL_FIELDS:
         limits = spec.material_range
         if limits is None:  # a choice

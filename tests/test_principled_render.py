@@ -1,5 +1,5 @@
 """The Principled fallback against Cycles (addon/scenes.py): the
-model of lut.principled is Cycles' Principled BSDF, and the fitted fallback
+model of lut.render.principled is Cycles' Principled BSDF, and the fitted fallback
 of a material, as rendered, has the error the fit reports and beats the
 Principled an artist would set up; the fallback leaves what Cycles and
 EEVEE render of the paint unchanged and is what glTF and USD export."""
@@ -15,7 +15,7 @@ bpy = pytest.importorskip("bpy")
 import lut  # noqa: E402
 from addon.scenes import EEVEE, Oracle, principled_params_material, relative_rms  # noqa: E402
 from addon.scenes import principled as artists_principled  # noqa: E402
-from lut import principled  # noqa: E402
+from lut.render import principled  # noqa: E402
 
 pytestmark = pytest.mark.render
 
@@ -59,7 +59,7 @@ def test_fitted_fallback_renders_with_its_error_and_beats_the_artist(oracle, nam
     paint = lut.preset(name)
     material = oracle.material("paint")
     api.set_paint(material, paint)
-    params, error = export.update_fallback(material)
+    params, error = export.update_fallback(material, api.paint_of(material))
     # Not baked yet: the fallback is what renders (no engine outputs).
     rendered = relative_rms(oracle, paint)
     assert rendered == pytest.approx(error, rel=0.02, abs=5e-4)
@@ -81,7 +81,7 @@ def test_fallback_changes_no_engine_render_and_is_exported(oracle, lut_dir, tmp_
     for engine in ("CYCLES", EEVEE):
         oracle.scene.render.engine = engine
         before[engine] = oracle.radiance(*geometry)
-    params, _ = export.update_fallback(material)
+    params, _ = export.update_fallback(material, api.paint_of(material))
     try:
         for engine in ("CYCLES", EEVEE):
             oracle.scene.render.engine = engine
@@ -92,7 +92,7 @@ def test_fallback_changes_no_engine_render_and_is_exported(oracle, lut_dir, tmp_
     assert outputs[export.OUTPUT].is_active_output and outputs[export.OUTPUT].target == "ALL"
     # Re-baking rewires the engine outputs; refreshing the fallback restores it.
     api.bake_material(material, directory=lut_dir, resolution=(8, 6, 4))  # a small LUT: only the wiring matters
-    export.update_fallback(material)
+    export.update_fallback(material, api.paint_of(material))
     assert [nd.target for nd in material.node_tree.nodes if nd.type == "OUTPUT_MATERIAL"].count("ALL") == 1
 
     path = tmp_path / "paint.gltf"
