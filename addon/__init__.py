@@ -17,7 +17,7 @@ _MODULES = (properties, operators, panels, library)
 def _expose_openimageio():
     """lut writes EXR files with OpenImageIO when it can: inside Blender 4.4+
     use the bundled module unless one is importable already.  Blender 4.2-4.3
-    have none; lut then uses its own numpy EXR code (lut.exr)."""
+    have none; lut then uses its own numpy EXR code (lut.lutfiles.exr)."""
     try:
         import OpenImageIO  # noqa: F401
     except ImportError:

@@ -6,13 +6,13 @@ top-level ``lut`` of another extension could shadow ours.  So the extension
 zip (scripts/build_extension.py) ships the library as ``paint_lut_core``;
 the repository keeps ``lut`` (tests and scripts import it), and the add-on
 run from the repository uses that.  Every add-on module imports the library
-from here:
+from here, by the names below:
 
-    from ._lut import lut                  # instead of: import lut / import lut.X
-    from ._lut import closures, render     # instead of: from lut import closures, render
+    from ._lut import lut                  # instead of: import lut
+    from ._lut import closures, fitting    # instead of: from lut.render import closures, fitting
 
-Submodules load on first use (``from ._lut import X`` is ``lut.X``); the
-ones below load with the package, so ``lut.X`` attribute access works."""
+Those names are the library modules the add-on uses, one line each with
+its path in the library's layers (``lut/__init__.py``)."""
 
 from __future__ import annotations
 
@@ -28,15 +28,17 @@ except ModuleNotFoundError as error:
         raise
     lut = importlib.import_module("lut")
 
-for _name in ("closures", "fitting", "lutfile", "models", "principled", "render"):
-    importlib.import_module(f"{lut.__name__}.{_name}")
+
+def _module(path: str):
+    return importlib.import_module(f"{lut.__name__}.{path}")
 
 
-def __getattr__(name):
-    """``from ._lut import X``: the library's submodule X (PEP 562)."""
-    if name.startswith("__"):
-        raise AttributeError(name)
-    try:
-        return importlib.import_module(f"{lut.__name__}.{name}")
-    except ModuleNotFoundError as error:
-        raise AttributeError(f"the paint library has no module {name!r}") from error
+schema = _module("paint.schema")
+exr = _module("lutfiles.exr")
+files = _module("lutfiles.files")
+lutfile = _module("lutfiles.format")
+closures = _module("render.closures")
+eevee = _module("render.eevee")
+fitting = _module("render.fitting")
+principled = _module("render.principled")
+render_bake = _module("render.bake")

@@ -1,4 +1,4 @@
-"""Background bakes: ``lut.render.bake_for_render`` (the paint type's LUT and
+"""Background bakes: ``lut.render.bake.bake_for_render`` (the paint type's LUT and
 every engine's fit) on a worker thread, with progress and cancellation over
 the whole of it, so the interface never blocks.  Pure Python (no bpy), so it
 is tested without a window."""
@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import threading
 
-from ._lut import closures, lut, render
+from ._lut import closures, lut, render_bake
 
 
 class Cancelled(Exception):
@@ -16,7 +16,7 @@ class Cancelled(Exception):
 
 class BakeJob:
     """Bake one paint on a thread.  ``progress`` (0..1), ``done``,
-    ``result`` (on success: the ``lut.render.RenderBake``), ``error`` (a
+    ``result`` (on success: the ``lut.render.bake.RenderBake``), ``error`` (a
     message) and ``cancel()``."""
 
     def __init__(self, paint: lut.Paint, directory, exact_metallic=True, targets=closures.TARGETS, **options):
@@ -55,7 +55,7 @@ class BakeJob:
 
     def _run(self):
         try:
-            result = render.bake_for_render(
+            result = render_bake.bake_for_render(
                 self.paint, self.directory, targets=self.targets, exact_metallic=self.exact_metallic,
                 progress=self._progress, **self.options,
             )  # fmt: skip

@@ -2,7 +2,7 @@
 bake on first use.
 
 ``assets/paint_lut_library.blend`` (written by scripts/make_assets.py) holds
-one material per paint of ``lut.presets.LIBRARY``, marked as an asset with a
+one material per paint of ``lut.paint.presets.LIBRARY``, marked as an asset with a
 rendered preview, and ``assets/blender_assets.cats.txt`` its catalogs.
 Blender 4.2 to 5.2 have no manifest entry for an extension's asset library,
 so ``register`` adds the folder to the Preferences' asset libraries
@@ -36,7 +36,7 @@ LIBRARY_BLEND = ASSETS / "paint_lut_library.blend"
 LIBRARY_NAME = "Paint LUT"
 
 #: ID properties of a library material: the library paint it is (a name of
-#: ``lut.presets.LIBRARY``), whether it still waits for its first bake, and
+#: ``lut.paint.presets.LIBRARY``), whether it still waits for its first bake, and
 #: why that bake failed (if it did).
 PAINT = "paint_lut_library"
 FIRST_USE = "paint_lut_first_use"

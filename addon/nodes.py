@@ -1,7 +1,7 @@
 """Node groups that render a paint type: closures weighted per view angle,
 coloured by the group's inputs.
 
-A paint's BRDF is Σ_c a_c·B_c (``lut.baking``): angular components of the
+A paint's BRDF is Σ_c a_c·B_c (``lut.lutfiles.baking``): angular components of the
 paint type scaled by colour amplitudes.  The group of a type and render
 target (``build_group``) takes the colours as inputs,
 
@@ -11,7 +11,7 @@ target (``build_group``) takes the colours as inputs,
 * ``Surface Reflection``       the facet weight,
 
 reads the closure weights w_kc(θv) from the fit's Non-Color EXR
-(``lut.fitting.write_fit``) at u = cos θv (Geometry Incoming · Normal), and
+(``lut.render.fitting.write_fit``) at u = cos θv (Geometry Incoming · Normal), and
 gives closure k the colour Σ_c a_c·w_kc.  Any colour source (an Image
 Texture, an Attribute, Object Info › Random) connected to an input renders
 the paint of that colour per pixel, and a colour edit is an input edit:
@@ -41,7 +41,7 @@ INPUTS = ("Pigment Color", "Single Scattering Color", "Surface Reflection")
 #: Fresnel for extinction 0 from Blender 5.0 on; 4.3-4.5 use an approximate
 #: conductor Fresnel (1.29-1.50x off for k = 0) and 4.2 has no Metallic BSDF.
 #: There the facet lobes are Principled BSDFs with a black base (exact
-#: dielectric Fresnel, GGX: lut.closures' "ggx" kind, fitted as such), and
+#: dielectric Fresnel, GGX: lut.render.closures' "ggx" kind, fitted as such), and
 #: the mirror is a Principled BSDF of roughness 0.  The default of every
 #: ``exact_metallic`` parameter in the add-on.
 EXACT_METALLIC = bpy.app.version >= (5, 0, 0)
@@ -424,7 +424,7 @@ def _oren_nayar(tree, links, lay, closure, rows_k, amps, exact_metallic):
     return total
 
 
-#: How each closure kind of ``lut.closures.CLOSURE_KINDS`` is built.
+#: How each closure kind of ``lut.render.closures.CLOSURE_KINDS`` is built.
 NODE_BUILDERS = {
     "lambert": _coloured("ShaderNodeBsdfDiffuse", _setup_lambert),
     "diffuse_toon": _coloured("ShaderNodeBsdfToon", _setup_toon),

@@ -20,11 +20,16 @@ import sys
 import time
 import tomllib
 
-from . import __version__, baking, cleanup, colour_management, lutfile, presets, render, table
-from .baking import BAKE_SINGLE_NODES
+from . import __version__
+from .colour import management as colour_management
+from .lutfiles import baking, cleanup, table
+from .lutfiles import format as lutfile
+from .lutfiles.baking import BAKE_SINGLE_NODES
 from .models.rough import DIFFUSE_NODES
-from .paint import Paint
-from .schema import PAINT_FIELDS, check_range
+from .paint import presets
+from .paint.core import Paint
+from .paint.schema import PAINT_FIELDS, check_range
+from .render import bake as render_bake
 
 DEFAULT_OUT = "out"
 #: The largest LUT the command line bakes: N_u * N_theta_d * N_phi_d nodes
@@ -161,7 +166,7 @@ def _cmd_bake(args) -> int:
     print(f"{path}  ({seconds:.2f} s)")
     # The LUT holds the paint type; the colours are the renderer's inputs.
     rbar = baking.load_lut(path).internal_reflectance
-    for name, value in render.node_inputs(paint, rbar).items():
+    for name, value in render_bake.node_inputs(paint, rbar).items():
         shown = value if isinstance(value, float) else "(" + ", ".join(f"{v:.6g}" for v in value) + ")"
         print(f"  {name}: {shown}")
     return 0
@@ -273,7 +278,7 @@ def build_parser() -> argparse.ArgumentParser:
     source = b.add_mutually_exclusive_group()
     source.add_argument("--preset", choices=list(presets.PRESETS), help="one of the paper's three samples")
     source.add_argument("--paint", metavar="FILE", help="a .json or .toml file of paint fields (see docs/lut.md)")
-    for spec in OPTIONS:  # the paint's fields (lut.schema)
+    for spec in OPTIONS:  # the paint's fields (lut.paint.schema)
         if spec.kind == "colour":
             kind = {"nargs": "+", "metavar": "V"}
         elif spec.choices:

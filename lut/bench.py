@@ -7,8 +7,9 @@ import time
 
 import numpy as np
 
-from . import fitting, models
+from . import models
 from .models import reference
+from .render import fitting
 
 CLOSED_FORM = {
     "facet_reflection": (models.facet_reflection, {"n": 1.5, "slope": 0.3}),
@@ -169,7 +170,7 @@ def bake_time_vs_error(paints, settings=BAKE_SETTINGS, directory=None, count=200
     quadrature, on ``count`` random directions.  Returns {name: [rows]}."""
     import tempfile
 
-    from . import baking
+    from .lutfiles import baking
 
     ti, ts, ps = validation_angles(count)
     report = {}
@@ -195,7 +196,7 @@ def random_paints(count=24, seed=2026):
     over a dark pigment; g uniform over -0.7..0.8 (both signs); a quarter
     smooth, the rest slopes log-uniform over 0.05-3 with either distribution;
     surface reflection 0.5-1.  Returns [(label, lut.Paint)]."""
-    from .paint import Paint
+    from .paint.core import Paint
 
     rng = np.random.default_rng(seed)
     out = []
@@ -228,7 +229,7 @@ def dark_paints(count=24, seed=2027):
     slopes log-uniform over 0.05-3 with either distribution (alternating),
     surface reflection 0.5-1.  The corner of the panel where the render path
     shows the facet term almost alone.  Returns [(label, lut.Paint)]."""
-    from .paint import Paint
+    from .paint.core import Paint
 
     rng = np.random.default_rng(seed)
     out = []
@@ -248,14 +249,15 @@ def dark_paints(count=24, seed=2027):
 
 
 def render_bake_times(paints, directory, repeat=1, eevee_calibration=(5, 0)):
-    """Seconds of a cold ``lut.render.bake_for_render`` (the paint type's LUT
+    """Seconds of a cold ``lut.render.bake.bake_for_render`` (the paint type's LUT
     and every engine's fit, as the add-on's Bake does) per paint, split into
     the LUT and the fits, and of a cached one (another colour of the type):
     [(label, lut seconds, fits seconds, total, cached seconds)], best of
     ``repeat``."""
     import tempfile
 
-    from . import baking, render
+    from .lutfiles import baking
+    from .render import bake as render_bake
 
     rows = []
     for label, paint in paints:
@@ -265,9 +267,11 @@ def render_bake_times(paints, directory, repeat=1, eevee_calibration=(5, 0)):
                 start = time.perf_counter()
                 baking.bake(paint, tmp)
                 lut_done = time.perf_counter()
-                render.bake_for_render(paint, tmp, eevee_calibration=eevee_calibration)  # the LUT is cached: fits only
+                render_bake.bake_for_render(
+                    paint, tmp, eevee_calibration=eevee_calibration
+                )  # the LUT is cached: fits only
                 end = time.perf_counter()
-                render.bake_for_render(paint, tmp, eevee_calibration=eevee_calibration)  # all cached
+                render_bake.bake_for_render(paint, tmp, eevee_calibration=eevee_calibration)  # all cached
                 cached = time.perf_counter() - end
                 row = (lut_done - start, end - lut_done, end - start, cached)
                 if best is None or row[2] < best[2]:

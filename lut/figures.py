@@ -16,8 +16,9 @@ import pathlib
 
 import numpy as np
 
-from . import models, presets
-from .files import atomic_target
+from . import models
+from .lutfiles.files import atomic_target
+from .paint import presets
 
 THETA_I = np.radians(60.0)
 SIGMAS = (0.05, 0.1, 0.2, 0.3, 0.5, 1.0)
@@ -35,7 +36,7 @@ def _pyplot():
 
 
 def _save(fig, path):
-    """Write a figure atomically (``lut.files.atomic_target``)."""
+    """Write a figure atomically (``lut.lutfiles.files.atomic_target``)."""
     with atomic_target(path) as tmp:
         fig.savefig(tmp, dpi=110, format="png")
     return path

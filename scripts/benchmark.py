@@ -19,8 +19,10 @@ import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
-from lut import bench, files, presets, table  # noqa: E402
-from lut.baking import BAKE_SINGLE_NODES  # noqa: E402
+from lut import bench  # noqa: E402
+from lut.lutfiles import files, table  # noqa: E402
+from lut.lutfiles.baking import BAKE_SINGLE_NODES  # noqa: E402
+from lut.paint import presets  # noqa: E402
 
 DEFAULT_PLOT = "out/bake_benchmark.png"
 

@@ -17,7 +17,8 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import lut  # noqa: E402
-from lut import bench, table  # noqa: E402
+from lut import bench  # noqa: E402
+from lut.lutfiles import table  # noqa: E402
 
 
 def main(argv=None) -> int:

@@ -14,7 +14,7 @@ the add-on imports it through addon/_lut.py.  The development-only modules
 
 The one wheel is pure Python and serves Linux, Windows and macOS alike: at run
 time lut needs only numpy and OpenImageIO, which Blender 5.0 ships, and its
-colour numbers are stored data (lut/colour_data.py), so neither
+colour numbers are stored data (lut/colour/data.py), so neither
 colour-science nor scipy (per-platform wheels) is bundled.
 
 The zip is built and validated by Blender's own extension builder: ``blender

@@ -1,5 +1,5 @@
 """Measure how EEVEE renders the closures a Paint LUT fit may use, and write
-the tables ``lut.eevee`` interpolates (``lut/eevee_tables.py``).
+the tables ``lut.render.eevee`` interpolates (``lut/render/eevee_tables.py``).
 
 Method.  A grid of spheres (one closure each, white, unit weight) under a
 delta Sun (angle 0, no shadows) in a black world, seen by an orthographic
@@ -11,14 +11,14 @@ the mirror direction).  One render fixes the angle γ between l and v; a
 sweep of γ covers (θl, θv, |φ|).  The pixels are binned on a grid of (θl,
 θv, |φ|) and each bin stores the ratio Σ EEVEE / Σ reference of its pixels,
 the reference being a smooth analytic model of what EEVEE approximates
-(``lut.eevee.reference``): so a table cell is a slowly varying correction,
+(``lut.render.eevee.reference``): so a table cell is a slowly varying correction,
 and lobes of any roughness keep their analytic shape between cells.
 
 Run ``python scripts/calibrate_eevee.py`` with a Python whose ``bpy`` renders
 EEVEE; the tables of that Blender line (``bpy.app.version[:2]``) are added to
 the file, those of other lines kept (``--only KIND ...``: only those kinds
 are measured, and added to the line's other tables).  New tables change
-what EEVEE fits are made from: bump ``lut.fitting.FIT_VERSION`` with them,
+what EEVEE fits are made from: bump ``lut.render.fitting.FIT_VERSION`` with them,
 so cached fits are made again."""
 
 from __future__ import annotations
@@ -37,8 +37,9 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from lut import eevee, files  # noqa: E402
-from lut.closures import RETRO_ROUGHNESS, Closure  # noqa: E402
+from lut.lutfiles import files  # noqa: E402
+from lut.render import eevee  # noqa: E402
+from lut.render.closures import RETRO_ROUGHNESS, Closure  # noqa: E402
 
 #: The generated module of tables.
 MODULE = ROOT / "lut" / "eevee_tables.py"
@@ -253,7 +254,7 @@ def geometry(normal, light, view=(0.0, 0.0, 1.0)):
 
 
 def bin_ratios(samples, closure):
-    """Σ EEVEE / Σ reference per cell of ``lut.eevee``'s grid (cell centres
+    """Σ EEVEE / Σ reference per cell of ``lut.render.eevee``'s grid (cell centres
     at the grid nodes), NaN where no pixel fell or the reference is nil."""
     tl = np.concatenate([s[0] for s in samples])
     tv = np.concatenate([s[1] for s in samples])
@@ -276,7 +277,7 @@ def bin_ratios(samples, closure):
 
 
 def write_module(path, version, tables, merge=False):
-    """Write ``lut/eevee_tables.py``: the tables of ``version`` replace that
+    """Write ``lut/render/eevee_tables.py``: the tables of ``version`` replace that
     line's (``merge``: are added to that line's, replacing only those of the
     same keys), other lines' are kept."""
     path = pathlib.Path(path)
@@ -291,7 +292,7 @@ def write_module(path, version, tables, merge=False):
     lines = [
         '"""EEVEE calibration tables by Blender line, made by scripts/calibrate_eevee.py',
         "(do not edit): for each line, the base64 of a compressed .npz (numpy alone reads",
-        'it: lut.eevee.decode) of per-closure ratio tables on lut.eevee\'s grid."""',
+        'it: lut.render.eevee.decode) of per-closure ratio tables on lut.render.eevee\'s grid."""',
         "",
         "# ruff: noqa: E501",
         "# fmt: off",

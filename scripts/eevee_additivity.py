@@ -23,7 +23,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from lut.closures import Closure  # noqa: E402
+from lut.render.closures import Closure  # noqa: E402
 from scripts.calibrate_eevee import SphereScene  # noqa: E402
 
 #: (closure, weight) in the order the sums take them: two diffuse closures

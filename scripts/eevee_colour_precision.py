@@ -17,7 +17,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from lut.closures import Closure  # noqa: E402
+from lut.render.closures import Closure  # noqa: E402
 from scripts.calibrate_eevee import SphereScene  # noqa: E402
 
 #: Colour weights measured, and the closures (a diffuse and a reflection one).

@@ -36,7 +36,9 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from lut import bench, files, fitting  # noqa: E402
+from lut import bench  # noqa: E402
+from lut.lutfiles import files  # noqa: E402
+from lut.render import fitting  # noqa: E402
 
 #: Light-view angles of the sweep (degrees).
 GAMMAS = tuple(range(0, 176, 10))

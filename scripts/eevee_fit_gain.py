@@ -1,5 +1,5 @@
 """What the EEVEE calibration buys: the EEVEE fit of a paint type made with
-``lut.eevee.evaluate`` (EEVEE's measured closures) in place of
+``lut.render.eevee.evaluate`` (EEVEE's measured closures) in place of
 ``Closure.evaluate`` (Cycles' formulas), rendered by EEVEE and measured
 against the model like ``scripts/render_fidelity.py`` (the plane oracle of
 addon/scenes.py on its EEVEE grid, cos-weighted relative RMS).
@@ -8,8 +8,8 @@ addon/scenes.py on its EEVEE grid, cos-weighted relative RMS).
 
 Per paint it prints the error of an EEVEE fit made with Cycles' formulas
 and of the add-on's, made with the calibrated evaluator
-(``lut.fitting.fit_lut(..., calibration=...)``), each rendered by EEVEE and
-as ``lut.eevee`` predicts it."""
+(``lut.render.fitting.fit_lut(..., calibration=...)``), each rendered by EEVEE and
+as ``lut.render.eevee`` predicts it."""
 
 from __future__ import annotations
 
@@ -25,7 +25,8 @@ import bpy  # noqa: E402
 
 from addon import nodes  # noqa: E402
 from addon.scenes import EEVEE, GRID_EEVEE, Oracle, paints, relative_rms  # noqa: E402
-from lut import eevee, fitting, render  # noqa: E402
+from lut.render import bake as render_bake  # noqa: E402
+from lut.render import eevee, fitting  # noqa: E402
 
 
 def _grams(table, fit, evaluate, grid):
@@ -39,7 +40,7 @@ def rendered_error(oracle, paint, fit, weights_path, label):
     fitting.write_fit(fit, weights_path)
     material = oracle.material(label)
     group = nodes.build_group(fit, weights_path)
-    nodes.wire(material, {"EEVEE": group}, render.node_inputs(paint, fit.internal_reflectance))
+    nodes.wire(material, {"EEVEE": group}, render_bake.node_inputs(paint, fit.internal_reflectance))
     return relative_rms(oracle, paint, GRID_EEVEE)
 
 
@@ -57,7 +58,7 @@ def main(argv=None):
     all_paints = paints()
     for name in args.paints:
         paint = all_paints[name]
-        baked = render.bake_for_render(paint, directory, targets=("EEVEE",), eevee_calibration=version)
+        baked = render_bake.bake_for_render(paint, directory, targets=("EEVEE",), eevee_calibration=version)
         table, default = baked.lut, baked.fits["EEVEE"]
         amps = table.amplitudes(paint)
         variants = {
@@ -73,7 +74,7 @@ def main(argv=None):
             kinds = ", ".join(f"{c.kind}" + (f" r{c.roughness:g}" if c.kind in ("glossy", "metallic") else "")
                               for c in fit.closures)  # fmt: skip
             print(
-                f"{name:13s} {label:26s} EEVEE render {got:.4f}  predicted with lut.eevee {predicted:.4f}  [{kinds}]",
+                f"{name:13s} {label:26s} EEVEE render {got:.4f}  predicted {predicted:.4f}  [{kinds}]",
                 flush=True,
             )
 

@@ -1,13 +1,13 @@
 """How close EEVEE's lobes can come to a paint's facet term at all: per view,
 the best Lambert + two-lobe combination EEVEE sums exactly, with each
 view's own pair of roughnesses (which no node group offers: the fit's pair
-is one for all views), from EEVEE's measured responses (``lut.eevee``).
+is one for all views), from EEVEE's measured responses (``lut.render.eevee``).
 
     .venv/bin/python scripts/eevee_lobe_limit.py [--paints 2 13 17 21 23] [--version 5.0]
 
 For each paint of ``lut.bench.random_paints`` named by its index, it bakes
 the type's LUT and prints the facet component's relative RMS on the fit's
-rows (``lut.fitting.light_rows``, the measure the fit minimises) for the
+rows (``lut.render.fitting.light_rows``, the measure the fit minimises) for the
 views of the acceptance range (θv <= 75°): the add-on's fit, and the
 per-view best pair out of 15 Glossy roughnesses.  Numpy only."""
 
@@ -26,9 +26,11 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from lut import baking, bench, eevee, fitting  # noqa: E402
-from lut.closures import Closure  # noqa: E402
-from lut.nnls import nnls_gram  # noqa: E402
+from lut import bench  # noqa: E402
+from lut.lutfiles import baking  # noqa: E402
+from lut.render import eevee, fitting  # noqa: E402
+from lut.render.closures import Closure  # noqa: E402
+from lut.render.nnls import nnls_gram  # noqa: E402
 
 ROUGHNESS = (0.05, 0.1, 0.15, 0.2, 0.25, 0.3, 0.35, 0.4, 0.45, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0)
 

@@ -25,7 +25,10 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from lut import bench, files, fitting, render  # noqa: E402
+from lut import bench  # noqa: E402
+from lut.lutfiles import files  # noqa: E402
+from lut.render import bake as render_bake  # noqa: E402
+from lut.render import fitting  # noqa: E402
 
 SETS = {"random": bench.random_paints, "dark": bench.dark_paints}
 
@@ -37,8 +40,8 @@ LIMIT_TYPES = (("gaussian", 1.0), ("gaussian", 2.0), ("exponential", 2.0), ("exp
 def limits(directory, budgets=(8, 12, 40)):
     """[(distribution, slope, {budget: Cycles error})] of ``LIMIT_TYPES`` on
     ρ = 0.02, no single scattering, surface reflection 1."""
-    from lut import baking
-    from lut.paint import Paint
+    from lut.lutfiles import baking
+    from lut.paint.core import Paint
 
     rows = []
     for distribution, slope in LIMIT_TYPES:
@@ -54,8 +57,8 @@ def measure(paints, directory):
     """[(label, paint, {"CYCLES", "CYCLES 4.x", "EEVEE": reported error})]."""
     rows = []
     for label, paint in paints:
-        errors = render.bake_for_render(paint, directory, eevee_calibration=(5, 0)).errors(paint)
-        errors["CYCLES 4.x"] = render.bake_for_render(
+        errors = render_bake.bake_for_render(paint, directory, eevee_calibration=(5, 0)).errors(paint)
+        errors["CYCLES 4.x"] = render_bake.bake_for_render(
             paint, directory, targets=("CYCLES",), exact_metallic=False
         ).errors(paint)["CYCLES"]
         rows.append((label, paint, errors))

@@ -12,7 +12,7 @@ run by Blender 4.2's Python module (the oldest supported Blender; see
 (pip bpy 4.2 ends with a segmentation fault at interpreter exit in any
 script that registered the add-on; everything is written before.)
 
-For every paint of ``lut.presets.LIBRARY`` (the paper's three samples, then
+For every paint of ``lut.paint.presets.LIBRARY`` (the paper's three samples, then
 the common finishes) this writes a material into
 ``addon/assets/paint_lut_library.blend``, marked as an asset in a catalog of
 ``addon/assets/blender_assets.cats.txt``, with a Cycles-rendered preview.  A
@@ -41,7 +41,7 @@ import bpy  # noqa: E402
 
 import addon  # noqa: E402
 from addon import api, export, library  # noqa: E402
-from lut import presets  # noqa: E402
+from lut.paint import presets  # noqa: E402
 
 #: Catalogs of the library: (path, the paints in it).
 CATALOGS = {"Paint LUT/Paper Samples": tuple(presets.PRESETS), "Paint LUT/Finishes": tuple(presets.FINISHES)}

@@ -1,4 +1,4 @@
-"""Write lut/colour_data.py: the colour numbers a bake needs, computed with
+"""Write lut/colour/data.py: the colour numbers a bake needs, computed with
 colour-science, so that lut bakes without it (inside Blender).
 
     .venv/bin/python scripts/make_colour_data.py
@@ -14,8 +14,8 @@ import sys
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from lut import colour_management as cm  # noqa: E402
-from lut import files  # noqa: E402
+from lut.colour import management as cm  # noqa: E402
+from lut.lutfiles import files  # noqa: E402
 
 #: colour-science collections stored whole (the presets use two of its patches).
 COLLECTIONS = ("ColorChecker N Ohta",)
@@ -28,7 +28,7 @@ def build() -> str:
         f"{colour.__version__} by scripts/make_colour_data.py (do not edit).",
         "",
         "SPECTRAL_WEIGHTS[space]: the (3, 81) matrix of",
-        "lut.colour_management.compute_spectral_weights (CIE 1931 2 degree observer,",
+        "lut.colour.management.compute_spectral_weights (CIE 1931 2 degree observer,",
         "D65, 380-780 nm in 5 nm steps, Bradford to the working space).",
         "RGB_TO_RGB['A -> B']: colour-science's matrix_RGB_to_RGB with Bradford.",
         "SPECTRA['collection/name']: (wavelengths nm, values) of colour-science's",

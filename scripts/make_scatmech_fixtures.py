@@ -159,7 +159,7 @@ def build(count, seed):
 
 
 def _files(here):
-    """lut/files.py on its own: it needs only the standard library, while
+    """lut/lutfiles/files.py on its own: it needs only the standard library, while
     this script runs in SCATMECH's venv, which lacks lut's dependencies."""
     spec = importlib.util.spec_from_file_location("paint_lut_files", os.path.join(here, "..", "lut", "files.py"))
     module = importlib.util.module_from_spec(spec)

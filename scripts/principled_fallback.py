@@ -1,5 +1,5 @@
 """The Principled fallback's fidelity: per paint, the fitted Principled BSDF
-(lut.principled.fit_principled, as addon.export adds it) rendered by Cycles
+(lut.render.principled.fit_principled, as addon.export adds it) rendered by Cycles
 against the model, beside the Principled an artist would set up (ρ as base
 colour, IOR n, roughness sqrt(slope), Blender's default multiscatter GGX).
 
@@ -22,7 +22,7 @@ sys.path.insert(0, str(ROOT))
 import bpy  # noqa: E402,F401
 
 from addon.scenes import Oracle, paints, principled, principled_params_material, relative_rms  # noqa: E402
-from lut import principled as fallback  # noqa: E402
+from lut.render import principled as fallback  # noqa: E402
 
 fallback_material = principled_params_material
 
@@ -43,7 +43,7 @@ def main(argv=None) -> int:
         rows[name] = {"fit": error, "rendered": rendered, "artist": artist, "params": params.to_dict()}
         print(f"{name:16} {error:7.4f} {rendered:7.4f} {artist:7.4f}  {params}")
     if args.out:
-        from lut.files import atomic_write_text
+        from lut.lutfiles.files import atomic_write_text
 
         atomic_write_text(args.out, json.dumps(rows, indent=1))
     return 0

@@ -23,7 +23,8 @@ import bpy  # noqa: E402
 import addon  # noqa: E402
 import lut  # noqa: E402
 from addon import api, scenes  # noqa: E402
-from lut import bench, render  # noqa: E402
+from lut import bench  # noqa: E402
+from lut.render import bake as render_bake  # noqa: E402
 
 
 def timed(sc, repeat=3):
@@ -60,7 +61,7 @@ def main(argv=None):
         material = api.new_material(name, paint, directory=directory)
         sphere.data.materials[0] = material
         t = timed(sc)
-        cached = render.bake_for_render(paint, directory, eevee_calibration=api.eevee_calibration())
+        cached = render_bake.bake_for_render(paint, directory, eevee_calibration=api.eevee_calibration())
         closures = sum(c.cost for c in cached.fits[args.engine].closures)
         print(f"{name:28} {t:.3f} s  ratio {t / base:.2f}  ({closures} closures)")
 

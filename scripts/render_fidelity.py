@@ -29,7 +29,8 @@ import numpy as np  # noqa: E402
 
 import addon  # noqa: E402
 from addon.scenes import EEVEE, GRID, GRID_EEVEE, Oracle, paint_material, paints, principled, relative_rms  # noqa: E402
-from lut import bench, files  # noqa: E402
+from lut import bench  # noqa: E402
+from lut.lutfiles import files  # noqa: E402
 
 
 def measure(paint, directory, eevee=True, lobes_4x=True, baseline=True, cycles=True):

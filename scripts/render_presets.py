@@ -23,7 +23,7 @@ import bpy  # noqa: E402
 import addon  # noqa: E402
 import lut  # noqa: E402
 from addon import api, scenes  # noqa: E402
-from lut import files  # noqa: E402
+from lut.lutfiles import files  # noqa: E402
 
 
 def main(argv=None) -> int:

@@ -22,7 +22,7 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
 from lut import models  # noqa: E402
-from lut.baking import BAKE_SINGLE_NODES  # noqa: E402
+from lut.lutfiles.baking import BAKE_SINGLE_NODES  # noqa: E402
 from lut.models.rough import SINGLE_NODES  # noqa: E402
 
 REFERENCE = (16, 32)

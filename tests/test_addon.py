@@ -12,7 +12,8 @@ import pytest
 bpy = pytest.importorskip("bpy")
 
 import lut  # noqa: E402
-from lut import fitting, render  # noqa: E402
+from lut.render import bake as render_bake  # noqa: E402
+from lut.render import fitting  # noqa: E402
 
 SMALL = {"resolution": (8, 6, 4)}
 
@@ -69,7 +70,7 @@ def test_material_properties_are_the_schemas_fields_with_its_limits(addon_regist
     """Every paint field the schema puts on a material is a property (and no
     other paint field is), with the schema's label, default, tooltip, hard
     and soft limits; the hard limits lie within what lut.Paint accepts."""
-    from lut.schema import PAINT_FIELDS
+    from lut.paint.schema import PAINT_FIELDS
 
     props = addon_registered.properties.PaintLUTSettings.bl_rna.properties
     on_material = {name for name, spec in PAINT_FIELDS.items() if spec.on_material}
@@ -211,14 +212,14 @@ def test_background_job_reports_progress_and_cancels_anywhere(tmp_path):
 
     def progress(fraction, original=late._progress):
         seen.append(fraction)
-        if fraction >= render.LUT_SHARE:
+        if fraction >= render_bake.LUT_SHARE:
             late.cancel()
         original(fraction)
 
     late._progress = progress
     late.start()
     assert late.wait(120) and late.error == "cancelled" and late.result is None
-    assert max(seen) >= render.LUT_SHARE
+    assert max(seen) >= render_bake.LUT_SHARE
     assert not list((tmp_path / "late").glob("paintfit-*"))  # no fit written after the cancel
     slow = jobs.BakeJob(lut.Paint(rho=0.4, single=0.3, slope=0.5), tmp_path / "slow", resolution=(96, 48, 24))
     slow.cancel()
@@ -322,7 +323,7 @@ def test_spectral_paints_are_stored_whole(fresh_file, tmp_path):
     assert settings.preset == "SPECTRAL" and not settings.stale
     assert api.paint_of(material) == paint
     assert settings.n == pytest.approx(float(paint.index_at(589.3)))
-    expected = render.node_inputs(paint)["Pigment Color"]
+    expected = render_bake.node_inputs(paint)["Pigment Color"]
     assert tuple(settings.rho) == pytest.approx(expected, abs=1e-6)
     blend = tmp_path / "blue.blend"
     bpy.ops.wm.save_as_mainfile(filepath=str(blend))
@@ -509,7 +510,7 @@ def test_a_paint_beyond_a_materials_limits_is_refused_naming_them(addon_register
     """check_paint_fits takes the panel fields' limits from the schema (equal
     to the properties', test above): just beyond one, the paint is refused."""
     from addon import validation
-    from lut.schema import PAINT_FIELDS
+    from lut.paint.schema import PAINT_FIELDS
 
     for name, spec in PAINT_FIELDS.items():
         if not spec.on_material or spec.material is None:

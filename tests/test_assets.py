@@ -11,7 +11,7 @@ import pathlib
 import pytest
 
 import lut
-from lut import gloss, presets
+from lut.paint import gloss, presets
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 ASSETS = ROOT / "addon" / "assets"

@@ -8,7 +8,9 @@ import numpy as np
 import pytest
 
 import lut
-from lut import lutfile, models, table
+from lut import models
+from lut.lutfiles import format as lutfile
+from lut.lutfiles import table
 
 RNG = np.random.default_rng(9)
 
@@ -229,7 +231,7 @@ def test_meta_is_plain_json(baked):
 
 
 def test_files_without_openimageio(tmp_path, monkeypatch):
-    """Blender 4.2-4.3 have no OpenImageIO module: lut.exr writes and reads
+    """Blender 4.2-4.3 have no OpenImageIO module: lut.lutfiles.exr writes and reads
     the same files, and each backend reads the other's."""
     paint = lut.Paint(rho=(0.7, 0.5, 0.2), single=0.2, slope=0.1)
     with_oiio = lut.bake(paint, tmp_path / "oiio", resolution=(8, 6, 4))

@@ -18,7 +18,7 @@ bpy = pytest.importorskip("bpy")
 import addon  # noqa: E402
 import lut  # noqa: E402
 from addon import api, batch  # noqa: E402
-from lut import lutfile  # noqa: E402
+from lut.lutfiles import format as lutfile  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SCRIPT = ROOT / "scripts" / "batch_bake.py"

@@ -1,4 +1,4 @@
-"""lut.closures, lut.nnls and lut.fitting: closure kinds, non-negative least
+"""lut.render.closures, lut.render.nnls and lut.render.fitting: closure kinds, non-negative least
 squares, and the fit of a paint type's LUT (numpy side)."""
 
 import functools
@@ -7,8 +7,12 @@ import numpy as np
 import pytest
 
 import lut
-from lut import baking, bench, closures, fitting, lutfile, render
-from lut.nnls import nnls, nnls_gram_batch
+from lut import bench
+from lut.lutfiles import baking
+from lut.lutfiles import format as lutfile
+from lut.render import bake as render_bake
+from lut.render import closures, fitting
+from lut.render.nnls import nnls, nnls_gram_batch
 
 
 def test_nnls_matches_scipy():
@@ -110,7 +114,7 @@ def test_eevee_fits_keep_to_two_reflection_closures_with_the_mirror(tmp_path):
     """EEVEE sums two reflection closures exactly: a smooth type's mirror is
     one, so its fit takes at most one more (a retro lobe, for a
     back-scattering pigment); a rough type's fit at most two lobes."""
-    from lut import eevee
+    from lut.render import eevee
 
     smooth = baking.load_lut(baking.bake(lut.Paint(rho=0.03, single=0.2, g=-0.5), tmp_path))
     rough = baking.load_lut(baking.bake(lut.Paint(rho=0.03, single=0.2, g=-0.5, slope=0.2), tmp_path))
@@ -184,7 +188,7 @@ def test_sharp_eevee_lobes_are_reported_as_the_dense_grid_sees_them(tmp_path):
     """A sharp Gaussian facet term of the randomised set (slope 0.078): on
     the acceptance grid's 180 points EEVEE's fit looks twice as good as it
     renders between them; the reported error is the dense grid's."""
-    from lut import eevee
+    from lut.render import eevee
 
     paint = dict(bench.random_paints())["#23 gau 0.0779 g +0.43"]
     table = baking.load_lut(baking.bake(paint, tmp_path))
@@ -305,7 +309,7 @@ def test_randomised_types_fit_within_their_targets():
     errors = {"smooth": [], "rough": []}
     with tempfile.TemporaryDirectory() as directory:
         for _, paint in bench.random_paints(12, seed=7):
-            result = render.bake_for_render(paint, directory, targets=("CYCLES",), resolution=(32, 16, 8))
+            result = render_bake.bake_for_render(paint, directory, targets=("CYCLES",), resolution=(32, 16, 8))
             errors["rough" if paint.slope > 0 else "smooth"].append(result.errors(paint)["CYCLES"])
     for kind, values in errors.items():
         goal = fitting.TARGET_ERROR["CYCLES"][kind]

@@ -1,4 +1,4 @@
-"""lut.colour_data: the stored colour numbers equal colour-science's, and lut
+"""lut.colour.data: the stored colour numbers equal colour-science's, and lut
 bakes spectral presets without colour-science (as inside Blender)."""
 
 import subprocess
@@ -8,8 +8,8 @@ import textwrap
 import numpy as np
 import pytest
 
-from lut import colour_data
-from lut import colour_management as cm
+from lut.colour import data as colour_data
+from lut.colour import management as cm
 
 colour = pytest.importorskip("colour")
 

@@ -12,7 +12,8 @@ pytest.importorskip("bpy")
 
 import lut  # noqa: E402
 from addon.scenes import Oracle, paint_material, paints, relative_rms  # noqa: E402
-from lut import bench, closures, fitting, models  # noqa: E402
+from lut import bench, models  # noqa: E402
+from lut.render import closures, fitting  # noqa: E402
 
 pytestmark = pytest.mark.render
 
@@ -90,7 +91,7 @@ UNIT_SINGLE = {"Pigment Color": (0.0, 0.0, 0.0), "Single Scattering Color": (1.0
 
 @pytest.mark.parametrize("closure", EVERY_KIND, ids=lambda c: c.kind)
 def test_every_closure_kind_renders_as_its_formula_through_the_node_group(registered_oracle, closure, tmp_path):
-    """Each kind's formula (lut.closures) against Cycles, through the very
+    """Each kind's formula (lut.render.closures) against Cycles, through the very
     node group the add-on builds for it (addon.nodes): a one-closure fit of
     weight 1 in the single-scatter component (the facet one for grey
     lobes), with that component's colour input 1."""
@@ -217,10 +218,10 @@ def test_ggx_closure_is_principled_with_a_black_base(oracle, n, roughness):
 
 def test_the_as_seen_group_computes_the_pigment_in_nodes(registered_oracle, tmp_path):
     """Rendered as emission, the As Seen group's output is the pigment ρ that
-    lut.render.pigment_of_seen gives (the panel's own inversion)."""
+    lut.render.bake.pigment_of_seen gives (the panel's own inversion)."""
     import bpy
 
-    from lut import render
+    from lut.render import bake as render_bake
 
     oracle = registered_oracle
     material, result = paint_material(oracle, lut.Paint(rho=0.5, slope=0.3), tmp_path, resolution=(16, 8, 4))
@@ -234,5 +235,5 @@ def test_the_as_seen_group_computes_the_pigment_in_nodes(registered_oracle, tmp_
     tree.links.new(node.outputs["Pigment Color"], emission.inputs["Color"])
     tree.links.new(emission.outputs[0], tree.get_output_node("CYCLES").inputs["Surface"])
     albedo = material.paint_lut.diffuse_albedo
-    want = render.pigment_of_seen(seen, albedo, result.lut.internal_reflectance)
+    want = render_bake.pigment_of_seen(seen, albedo, result.lut.internal_reflectance)
     np.testing.assert_allclose(oracle.radiance(0.3, 0.2, 1.0), want, rtol=1e-5)

@@ -1,4 +1,4 @@
-"""lut.eevee: EEVEE's measured closure responses (scripts/calibrate_eevee.py).
+"""lut.render.eevee: EEVEE's measured closure responses (scripts/calibrate_eevee.py).
 
 The evaluator's contract is checked with numpy alone; the tables themselves
 against fresh EEVEE renders of single geometries (the plane oracle, not the
@@ -9,8 +9,8 @@ import math
 import numpy as np
 import pytest
 
-from lut import closures, eevee
-from lut.closures import Closure
+from lut.render import closures, eevee
+from lut.render.closures import Closure
 
 CLOSURES = [
     Closure("lambert"),

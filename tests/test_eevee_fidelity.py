@@ -59,7 +59,7 @@ def test_cycles_renders_every_paint_within_its_target_on_the_dense_measure(rando
     """Every pixel of the spheres, not the 180 points of the acceptance grid:
     within the Cycles target, or, where the fit reports a miss (the Gaussian
     slope 2.88: rougher than any Blender lobe), near what it reports."""
-    from lut import fitting
+    from lut.render import fitting
 
     for row in randomised:
         target = fitting.TARGET_ERROR["CYCLES"]["rough" if row["paint"].slope > 0 else "smooth"]

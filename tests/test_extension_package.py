@@ -47,8 +47,9 @@ def test_zip_holds_the_add_on_manifest_and_lut_wheel(package):
         with zipfile.ZipFile(archive.open(wheel)) as inner:
             files = set(inner.namelist())
     package = build_extension.PACKAGE
-    assert {f"{package}/__init__.py", f"{package}/colour_data.py", f"{package}/models/rough.py"} <= files
-    assert f"{package}/principled.py" in files
+    assert {f"{package}/__init__.py", f"{package}/colour/data.py", f"{package}/models/rough.py"} <= files
+    assert {f"{package}/{layer}/__init__.py" for layer in ("colour", "paint", "lutfiles", "render")} <= files
+    assert f"{package}/render/principled.py" in files
     assert not any(f.startswith(("lut/", "addon/", "tests/")) for f in files)
     record = next(f for f in files if f.endswith(".dist-info/RECORD"))
     assert record.startswith("paint_lut-0.1.0.dist-info/")
@@ -70,8 +71,8 @@ def test_wheel_leaves_out_development_modules_and_still_imports(tmp_path):
         import importlib, sys
         sys.modules["matplotlib"] = None  # no matplotlib either
         for name in (
-            "", ".__main__", ".principled", ".render", ".fitting", ".lutfile", ".exr",
-            ".schema", ".files", ".presets", ".gloss", ".eevee",
+            "", ".__main__", ".render.principled", ".render.bake", ".render.fitting", ".lutfiles.format",
+            ".lutfiles.exr", ".paint.schema", ".lutfiles.files", ".paint.presets", ".paint.gloss", ".render.eevee",
         ):
             importlib.import_module("{package}" + name)
         from {package} import __main__ as cli

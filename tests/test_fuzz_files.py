@@ -1,7 +1,7 @@
 """Damaged LUT and weights files, with a fixed seed: every bit flip and every
 truncation either loads exactly the data that was written or raises
 lut.LUTError; never another exception.  Both readers: OpenImageIO (when
-installed) and the numpy fallback (lut.exr)."""
+installed) and the numpy fallback (lut.lutfiles.exr)."""
 
 import random
 
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import lut
-from lut import lutfile
+from lut.lutfiles import format as lutfile
 
 SEED = 20240611
 FLIPS = 160
@@ -32,7 +32,7 @@ def reader(request, monkeypatch):
 
 @pytest.fixture(scope="module")
 def lut_bytes(tmp_path_factory):
-    """A small LUT written both compressed (OpenImageIO) and not (lut.exr)."""
+    """A small LUT written both compressed (OpenImageIO) and not (lut.lutfiles.exr)."""
     directory = tmp_path_factory.mktemp("fuzz")
     path = lut.bake(lut.Paint(rho=(0.6, 0.3, 0.2), single=0.1, g=0.3), directory, resolution=RESOLUTION)
     table, header = lutfile.read(path)
@@ -55,7 +55,7 @@ def lut_bytes(tmp_path_factory):
 @pytest.fixture(scope="module")
 def weights_bytes(tmp_path_factory):
     """A closure fit's weights file, as the render path writes it."""
-    from lut import fitting
+    from lut.render import fitting
 
     directory = tmp_path_factory.mktemp("fuzz_weights")
     table = lut.load_lut(lut.bake(lut.Paint(rho=0.4, slope=0.3), directory, resolution=RESOLUTION))
@@ -108,7 +108,7 @@ def test_damaged_luts_load_identical_data_or_raise_lut_error(reader, lut_bytes, 
 
 
 def test_damaged_weights_load_identical_data_or_raise_lut_error(reader, weights_bytes, tmp_path):
-    from lut import fitting
+    from lut.render import fitting
 
     data, fit = weights_bytes  # ZIP-compressed when OpenImageIO wrote it: the fallback reads that too
     target = tmp_path / "paintfit-damaged.exr"
@@ -144,7 +144,7 @@ def test_bake_rebakes_a_lut_whose_metadata_is_not_utf8(reader, tmp_path):
 
 
 def test_a_weights_file_of_the_previous_release_is_refused_not_misread(tmp_path, reader):
-    from lut import fitting
+    from lut.render import fitting
 
     path = tmp_path / "paintfit-old.exr"
     lutfile.write_exr(path, np.ones((2, 3, 3), np.float32), {"paintlut:closures": "('lambert',)"})

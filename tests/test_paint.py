@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 import lut
-from lut import colour_management as cm
 from lut import models
+from lut.colour import management as cm
 
 RNG = np.random.default_rng(3)
 TI, TS, PS = RNG.uniform(0, 1.4, 200), RNG.uniform(0, 1.4, 200), RNG.uniform(-np.pi, np.pi, 200)

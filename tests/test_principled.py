@@ -1,4 +1,4 @@
-"""lut.principled: the model of Cycles' Principled BSDF and the fitted
+"""lut.render.principled: the model of Cycles' Principled BSDF and the fitted
 fallback (numpy only; the model's agreement with Cycles is checked in
 tests/test_principled_render.py)."""
 
@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 
 import lut
-from lut import principled
 from lut.models import fresnel
+from lut.render import principled
 
 
 def test_table_at_zero_roughness_is_the_fresnel_factor():

@@ -15,8 +15,9 @@ import numpy as np
 import pytest
 
 import lut
-from lut import files, lutfile
 from lut.__main__ import main
+from lut.lutfiles import files
+from lut.lutfiles import format as lutfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SMALL = ["--resolution", "8", "6", "4"]
@@ -54,7 +55,7 @@ def test_the_partial_file_of_a_killed_writer_is_removed_by_the_next_bake(tmp_pat
             textwrap.dedent(
                 f"""
                 import sys, time
-                from lut import files
+                from lut.lutfiles import files
                 with files.atomic_target({str(target)!r}) as tmp:
                     open(tmp, "wb").write(b"half a LUT")
                     print("writing", flush=True)
@@ -244,7 +245,7 @@ def test_info_into_a_closed_pipe_is_quiet(tmp_path):
 
 
 def test_ctrl_c_ends_with_one_line_and_status_130(tmp_path, capsys, monkeypatch):
-    from lut import baking
+    from lut.lutfiles import baking
 
     def interrupted(*args, **kwargs):
         raise KeyboardInterrupt
@@ -258,7 +259,7 @@ def test_ctrl_c_ends_with_one_line_and_status_130(tmp_path, capsys, monkeypatch)
 
 
 def test_clean_removes_only_luts_and_weights_nothing_keeps(tmp_path, capsys):
-    from lut import cleanup
+    from lut.lutfiles import cleanup
 
     kept = lut.bake(lut.Paint(rho=0.2), tmp_path, resolution=(8, 6, 4))
     gone = lut.bake(lut.Paint(n=1.6, rho=0.7), tmp_path, resolution=(8, 6, 4))  # another paint type

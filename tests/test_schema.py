@@ -1,4 +1,4 @@
-"""The paint fields' schema (lut.schema) against what is derived from it:
+"""The paint fields' schema (lut.paint.schema) against what is derived from it:
 lut.Paint, the command line's options and paint files, its limits, the
 one range check and docs/lut.md.  The add-on's properties are checked
 against it in test_addon.py."""
@@ -12,9 +12,9 @@ import pytest
 
 import lut
 from lut import __main__ as cli
-from lut import schema
 from lut.models import _validate
-from lut.schema import PAINT_FIELDS, Range
+from lut.paint import schema
+from lut.paint.schema import PAINT_FIELDS, Range
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 #: The bake command's options that are not paint fields.
@@ -139,4 +139,4 @@ def test_one_range_check_names_the_parameter_and_its_range(limits, noun, text):
 
 def test_docs_list_the_schemas_fields():
     text = (ROOT / "docs" / "lut.md").read_text()
-    assert schema.markdown_table() in text, "docs/lut.md: paste lut.schema.markdown_table() into its field table"
+    assert schema.markdown_table() in text, "docs/lut.md: paste lut.paint.schema.markdown_table() into its field table"

@@ -101,7 +101,7 @@ def check_range(value, name: str, allowed: Range, *, noun: str = REAL, context: 
     return number
 
 
-#: The models' parameter ranges (``lut.schema`` gives a paint's fields these).
+#: The models' parameter ranges (``lut.paint.schema`` gives a paint's fields these).
 INDEX = Range(0.0, None, low_open=True)
 ASYMMETRY = Range(-1.0, 1.0, low_open=True, high_open=True)
 REFLECTANCE = Range(0.0, 1.0)

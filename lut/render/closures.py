@@ -1,6 +1,6 @@
 """Blender closures as functions of the light and view directions (numpy
 only), and the candidate closures a paint type is fitted with
-(``lut.fitting``).
+(``lut.render.fitting``).
 
 Blender's shader nodes see the view direction, never the light's; only
 closures depend on the light.  So a paint is rendered as Σ_k w_k(θv)·b_k(l, v):
@@ -37,7 +37,7 @@ irradiance, cos θl included (what Cycles' eval returns), for a white closure:
   the view direction (Geometry › Incoming): the white GGX lobe
   D·G/(4 cos θv') in the frame of that normal, where θv' = 0 and the light
   is at the angle γ between l and v: a retro-reflection lobe that EEVEE
-  draws as a reflection closure (``lut.eevee``; EEVEE draws the retro Toon
+  draws as a reflection closure (``lut.render.eevee``; EEVEE draws the retro Toon
   as Lambert about the view, a diffuse closure of a normal of its own).
 * ``ggx``:          Principled BSDF with a black base and GGX roughness r: its
   dielectric specular layer alone, F·D_GGX(α = r²)·G/(4 cos θv) with the
@@ -54,8 +54,8 @@ import dataclasses
 
 import numpy as np
 
-from .models import facet, fresnel
-from .paint import reference_index
+from ..models import facet, fresnel
+from ..paint.core import reference_index
 
 
 @dataclasses.dataclass(frozen=True)
@@ -289,7 +289,7 @@ class ClosureKind:
 
 
 #: The closure kinds the fit and the node groups know (colour-science style
-#: registry: ``lut.fitting`` evaluates them, ``addon.nodes`` builds them).
+#: registry: ``lut.render.fitting`` evaluates them, ``addon.nodes`` builds them).
 CLOSURE_KINDS = {
     "lambert": ClosureKind(_lambert),
     "diffuse_toon": ClosureKind(_diffuse_toon),
@@ -352,7 +352,7 @@ def _lobes(type_dict, exact_metallic):
 
 
 #: Roughnesses of the retro GGX lobes an EEVEE fit of a smooth type may use
-#: (calibrated in ``lut.eevee``).
+#: (calibrated in ``lut.render.eevee``).
 RETRO_ROUGHNESS = (0.45, 0.6, 0.8, 1.0)
 
 
@@ -367,7 +367,7 @@ def candidates(type_dict: dict, target: str = "CYCLES", exact_metallic: bool = T
     (``exact_metallic``: Blender 5), Principled GGX otherwise (Blender
     4.2-4.5); for Cycles above a slope of 0.3 also velvet Sheen lobes, which
     rise toward grazing as very rough facet terms do.  EEVEE draws every
-    diffuse closure as Lambert (``lut.eevee``): Lambert and the lobes; for
+    diffuse closure as Lambert (``lut.render.eevee``): Lambert and the lobes; for
     a smooth type, whose mirror leaves one of EEVEE's two exact reflection
     closures free, retro GGX lobes (``retro_glossy``) for back-scattering
     pigments."""

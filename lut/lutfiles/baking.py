@@ -23,10 +23,11 @@ import pathlib
 
 import numpy as np
 
-from . import lutfile, table
-from .models import _validate
-from .models.rough import DIFFUSE_NODES
-from .paint import COMPONENTS, Paint
+from ..models import _validate
+from ..models.rough import DIFFUSE_NODES
+from ..paint.core import COMPONENTS, Paint
+from . import format as lutfile
+from . import table
 
 #: Bumped whenever a model change alters baked values, so old caches miss.
 MODEL_VERSION = 2

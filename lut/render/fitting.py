@@ -1,9 +1,9 @@
 """The fit of a paint type's LUT onto Blender closures, per view angle.
 
-A paint's non-delta BRDF is Σ_c a_c·B_c (``lut.baking``): colour-free
+A paint's non-delta BRDF is Σ_c a_c·B_c (``lut.lutfiles.baking``): colour-free
 angular components B_c scaled by colour amplitudes a_c.  Each component is
 fitted on its own as Σ_k w_kc(θv)·b_k(l, v) over closures b_k
-(``lut.closures``), so a node group renders any colour of the type by giving
+(``lut.render.closures``), so a node group renders any colour of the type by giving
 closure k the colour Σ_c a_c·w_kc(θv): the colour is a node input, never a
 bake.
 
@@ -28,7 +28,7 @@ The fit, per render target (``fit_lut``):
    serve the facet component only and keep weights <= 1 (a Mix Shader
    factor clamps there).
 3. Weights.  Non-negative least squares per view and component over the
-   chosen closures (``lut.nnls``).
+   chosen closures (``lut.render.nnls``).
 4. Error.  On the acceptance grid (θl, θv <= 75°, azimuths off the mirror)
    and on a dense grid of the same range (``DENSE_GRID``): the closures
    with their weights interpolated linearly in cos θv, against the LUT.
@@ -52,10 +52,11 @@ import pathlib
 
 import numpy as np
 
-from . import closures, lutfile
+from ..lutfiles import format as lutfile
+from ..paint.core import COMPONENTS, reference_index
+from . import closures
 from .closures import Closure
 from .nnls import nnls_gram_batch
-from .paint import COMPONENTS, reference_index
 
 #: Fit format version: bumped when the weights file layout or the fit changes.
 #: It is part of the weights file's name (``fit_path``), so a new release
@@ -461,7 +462,7 @@ def _cycles(closure, theta_l, theta_v, phi):
 def evaluator_for(target, calibration=None):
     """How the target renders each closure: Cycles' formulas
     (``Closure.evaluate``), or for EEVEE with a ``calibration`` (a Blender
-    line with measured tables, ``lut.eevee``) EEVEE's own responses."""
+    line with measured tables, ``lut.render.eevee``) EEVEE's own responses."""
     if target == "EEVEE" and calibration is not None:
         from . import eevee
 
@@ -480,11 +481,11 @@ def fit_lut(
     grid=LIGHT_GRID,
     calibration=None,
 ) -> Fit:
-    """Fit a loaded LUT (``lut.baking.LUT``) onto the closures of a render
+    """Fit a loaded LUT (``lut.lutfiles.baking.LUT``) onto the closures of a render
     target (module docstring).  ``budget``, ``extra_budget``: closures per
     material, and how many more while a component misses the target
     (defaults ``BUDGET``, ``EXTRA_BUDGET``).  ``calibration``: for EEVEE, the
-    Blender line whose measured closure responses to fit with (``lut.eevee``;
+    Blender line whose measured closure responses to fit with (``lut.render.eevee``;
     None: Cycles' formulas, EEVEE's own rendering unmodelled)."""
     target = closures.validate_target(target)
     evaluate = evaluator_for(target, calibration)

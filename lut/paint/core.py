@@ -9,7 +9,7 @@ or its rough counterpart) with weight ``single``, and f_diffuse the totally
 diffuse term (Eq. 27 or its rough counterpart) of substrate reflectance ρ.
 
 Colour.  ``rho`` and ``single`` are RGB triples in the paint's working space
-``space``, or spectra (``lut.colour_management.Spectrum``).  The diffuse term
+``space``, or spectra (``lut.colour.management.Spectrum``).  The diffuse term
 is non-linear in ρ, f_diffuse(ρ) = ρ(1 - r̄)/(1 - ρ r̄) · f_diffuse(1) (Eq. 27,
 and the same factor under a rough interface with its r̄), so an RGB paint
 applies that factor per channel, and a spectral paint per wavelength before
@@ -28,10 +28,10 @@ from typing import Any
 
 import numpy as np
 
-from . import colour_management as cm
-from . import models
-from .models import _validate, fresnel
-from .models.rough import DIFFUSE_NODES, SINGLE_NODES
+from .. import models
+from ..colour import management as cm
+from ..models import _validate, fresnel
+from ..models.rough import DIFFUSE_NODES, SINGLE_NODES
 from .schema import PAINT_FIELDS
 
 #: Band edges [nm] for a dispersive index: the geometry is evaluated at each
@@ -135,7 +135,7 @@ def _field_lines() -> str:
     return "\n".join(lines).lstrip()
 
 
-#: How each kind of field (``lut.schema.KINDS``) is checked and normalized.
+#: How each kind of field (``lut.paint.schema.KINDS``) is checked and normalized.
 _CHECKS = {
     "index": lambda spec, value: _index(value),
     "colour": lambda spec, value: _colour_value(value, spec.name),
@@ -149,7 +149,7 @@ _CHOICES = {"distribution": _validate.distribution, "space": cm.working_space}
 @dataclasses.dataclass(frozen=True)
 class Paint:
     """A paint (paper Sec. 4).  All fields are keywords; see the module
-    docstring for how they combine.  The fields (``lut.schema.PAINT_FIELDS``):
+    docstring for how they combine.  The fields (``lut.paint.schema.PAINT_FIELDS``):
 
     {fields}
     """

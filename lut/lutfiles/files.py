@@ -7,7 +7,7 @@ except where Blender writes the file itself (a .blend library, a render).
 
 The temporary file is hidden and named ``.<stem>.<pid>@<host>.<random>.partial<suffix>``:
 a later write in the folder removes it if its writer was killed
-(``remove_stale_partials``), and ``lut.cleanup`` lists it."""
+(``remove_stale_partials``), and ``lut.lutfiles.cleanup`` lists it."""
 
 from __future__ import annotations
 

@@ -3,7 +3,7 @@
 ``nnls(a, b)`` solves min ‖a x - b‖ with x >= 0 by the active-set method of
 Lawson and Hanson (*Solving Least Squares Problems*, 1974, ch. 23);
 ``nnls_gram(G, g)`` the same problem given its normal equations G = aᵀa,
-g = aᵀb, which is how the closure fit (``lut.fitting``) meets it: many small
+g = aᵀb, which is how the closure fit (``lut.render.fitting``) meets it: many small
 problems (a handful of unknowns) over hundreds of rows."""
 
 from __future__ import annotations

@@ -15,7 +15,7 @@ Everything else is derived from it:
   current).
 
 Adding a field to a paint is a ``FieldSpec`` here and its physics in
-lut/paint.py.  Every paint field is dimensionless (an index, reflectances,
+lut/paint/core.py.  Every paint field is dimensionless (an index, reflectances,
 weights, a slope): no field has a unit."""
 
 from __future__ import annotations
@@ -23,9 +23,9 @@ from __future__ import annotations
 import dataclasses
 from typing import Any
 
-from . import colour_management as cm
-from .models import _validate
-from .models._validate import Range, check_range, range_error  # noqa: F401  (the command line's and add-on's)
+from ..colour import management as cm
+from ..models import _validate
+from ..models._validate import Range, check_range, range_error  # noqa: F401  (the command line's and add-on's)
 
 #: The kinds of field: how a value is given, checked, shown and stored.
 #: ``index`` a number, or Cauchy coefficients in a spectral paint;

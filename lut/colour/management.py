@@ -1,7 +1,7 @@
 """Colour: spectra, working spaces and the spectral-to-RGB integration.
 
 Every number comes from colour-science (no hand-typed matrices), but the ones
-a bake needs are stored as data in ``lut.colour_data`` (made by
+a bake needs are stored as data in ``lut.colour.data`` (made by
 ``scripts/make_colour_data.py``; a test recomputes them), so baking presets
 and spectral paints does not import colour-science: Blender does not ship it
 and it would pull scipy into the extension.  colour-science is needed only to
@@ -21,7 +21,7 @@ import pathlib
 
 import numpy as np
 
-from .models import _validate
+from ..models import _validate
 
 #: Blender working-space names and their colour-science colourspaces.
 WORKING_SPACES = {
@@ -54,7 +54,7 @@ def working_space(name: str) -> str:
 def spectral_weights(space: str = DEFAULT_SPACE) -> np.ndarray:
     """Matrix W (3, len(WAVELENGTHS)) with RGB = W @ values for a
     reflectance-like spectrum (stored data; see ``compute_spectral_weights``)."""
-    from . import colour_data
+    from . import data as colour_data
 
     weights = np.array(colour_data.SPECTRAL_WEIGHTS[working_space(space)], dtype=float)
     weights.setflags(write=False)
@@ -64,7 +64,7 @@ def spectral_weights(space: str = DEFAULT_SPACE) -> np.ndarray:
 def rgb_to_rgb(source: str, target: str) -> np.ndarray:
     """3x3 matrix converting linear RGB of one working space to another
     (stored data; see ``compute_rgb_to_rgb``)."""
-    from . import colour_data
+    from . import data as colour_data
 
     return np.array(colour_data.RGB_TO_RGB[f"{working_space(source)} -> {working_space(target)}"], dtype=float)
 
@@ -212,7 +212,7 @@ def _is_number(text):
 
 
 def _dataset(name: str):
-    from . import colour_data
+    from . import data as colour_data
 
     if name in colour_data.SPECTRA:
         wavelengths, values = colour_data.SPECTRA[name]

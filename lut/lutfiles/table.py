@@ -1,5 +1,5 @@
 """The angular table behind a LUT: the polarization-averaged BRDF on a grid of
-Rusinkiewicz half/difference angles (``lut.angles``), and its interpolation.
+Rusinkiewicz half/difference angles (``lut.lutfiles.angles``), and its interpolation.
 
 Axes (nodes include both ends):
   u  in [0, 1] with θh = (π/2)·u²: the square-root spacing of the half angle
@@ -8,7 +8,7 @@ Axes (nodes include both ends):
      is 0.02°);
   θd in [0, π/2], uniform;
   φd in [0, π/2], uniform (isotropy, reciprocity and mirror symmetry fold
-     every φd there; ``lut.angles``).
+     every φd there; ``lut.lutfiles.angles``).
 The table stores G = f · cos θi · cos θs rather than f: the facet term's
 1/(cos θi cos θs) would otherwise vary steeply along θd near the horizon,
 while G is smooth for every term.  Nodes below the horizon store G continued

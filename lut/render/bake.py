@@ -14,8 +14,10 @@ import pathlib
 
 import numpy as np
 
-from . import baking, closures, fitting, lutfile
-from .paint import Paint, diffuse_amplitude, pigment_of_amplitude
+from ..lutfiles import baking
+from ..lutfiles import format as lutfile
+from ..paint.core import Paint, diffuse_amplitude, pigment_of_amplitude
+from . import closures, fitting
 
 #: Share of the progress bar taken by the LUT (the fits take the rest).
 LUT_SHARE = 0.7
@@ -74,10 +76,10 @@ def bake_for_render(
     **lut_options,
 ) -> RenderBake:
     """Bake the paint's type LUT (``lut.bake``) and fit it for each render
-    target (``lut.fitting.fit_lut``), writing the weights files beside it;
+    target (``lut.render.fitting.fit_lut``), writing the weights files beside it;
     valid cached files are reused unless ``force``.  ``eevee_calibration``:
     the Blender line whose measured EEVEE closure responses the EEVEE fit
-    uses (``lut.eevee.calibration_for(bpy.app.version)``; None: Cycles'
+    uses (``lut.render.eevee.calibration_for(bpy.app.version)``; None: Cycles'
     formulas).  ``progress(fraction)``
     (0..1) is called throughout and may raise to cancel: files already
     complete stay (they are valid caches), nothing is half-written."""

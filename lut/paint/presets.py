@@ -26,8 +26,8 @@ from __future__ import annotations
 
 import functools
 
-from .colour_management import Spectrum
-from .paint import Paint
+from ..colour.management import Spectrum
+from .core import Paint
 
 
 def glossy_white(space: str = "Linear Rec.709") -> Paint:
@@ -84,7 +84,7 @@ def preset(name: str, space: str = "Linear Rec.709") -> Paint:
 # are classified by specular gloss (ASTM D523 at 60°; the Master Painters
 # Institute's Gloss and Sheen Standards give each level a range), and in the
 # paper's facet model the interface's RMS slope is what sets it.  Each
-# finish's slope is chosen so that ``lut.gloss.specular_gloss`` at 60° falls
+# finish's slope is chosen so that ``lut.paint.gloss.specular_gloss`` at 60° falls
 # inside its MPI range (``GLOSS_RANGE``; tests/test_assets.py checks it).
 # What the paper gives and what is our choice:
 #

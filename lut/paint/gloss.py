@@ -14,7 +14,7 @@ BRDF integrated over the receptor aperture, plus the mirror reflection of a
 smooth interface; the source aperture (0.75° × 2.5° in the standard) is
 taken as a point, which only blurs lobes narrower than the receptor.  The
 standard's own reflection is its Fresnel reflectance (paper Sec. 2.4's
-facet model for a flat surface).  This is what ``lut.presets`` uses to put
+facet model for a flat surface).  This is what ``lut.paint.presets`` uses to put
 each finish's slope in its gloss range (MPI's Gloss and Sheen Standards:
 gloss at 60°, sheen at 85°)."""
 
@@ -22,8 +22,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import colour_management as cm
-from .models import fresnel
+from ..colour import management as cm
+from ..models import fresnel
 
 #: The primary standard's index (black glass, sodium D line).
 STANDARD_INDEX = 1.567

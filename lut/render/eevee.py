@@ -1,11 +1,11 @@
 """The closures as EEVEE renders them (numpy only): measured tables, by
 Blender line.
 
-EEVEE does not evaluate closures with Cycles' formulas (``lut.closures``).
+EEVEE does not evaluate closures with Cycles' formulas (``lut.render.closures``).
 ``scripts/calibrate_eevee.py`` renders each closure kind an EEVEE fit may use
 on spheres under a delta Sun and stores, per closure and Blender line, the
 ratio of EEVEE's radiance to a smooth analytic reference (``reference``) on
-a grid of (θl, θv, |φ|) (``THETA``, ``PHI``) in ``lut/eevee_tables.py``.
+a grid of (θl, θv, |φ|) (``THETA``, ``PHI``) in ``lut/render/eevee_tables.py``.
 ``evaluate`` is the reference times the interpolated ratio: the same
 contract as ``Closure.evaluate`` (contribution per unit irradiance, cos θl
 included; light at azimuth π, φ = 0 the mirror direction).
@@ -24,7 +24,7 @@ The references (what EEVEE was found to approximate):
 * ``metallic``: the same times the exact unpolarized dielectric Fresnel
   reflectance at the half vector, F(θd, n) (``lut.models.fresnel``).
 * ``retro_glossy``: the GGX lobe in the frame of its normal, the view
-  direction (``lut.closures``: viewer at θv' = 0, light at the angle γ
+  direction (``lut.render.closures``: viewer at θv' = 0, light at the angle γ
   between l and v).
 
 Between the calibrated roughnesses ``ROUGHNESS`` (and IORs ``IORS`` of the
@@ -39,14 +39,14 @@ import io
 
 import numpy as np
 
+from ..models import fresnel
 from .closures import RETRO_ROUGHNESS, Closure, ggx_lobe, light_view_angle
-from .models import fresnel
 
 #: The grid of the tables: θl and θv in 5° steps to 90°, |φ| in 15° steps.
 THETA = np.radians(np.arange(0.0, 90.1, 5.0))
 PHI = np.radians(np.arange(0.0, 180.1, 15.0))
 #: Calibrated roughnesses (glossy, metallic; the retro GGX lobes at
-#: ``lut.closures.RETRO_ROUGHNESS``) and Metallic BSDF IORs.
+#: ``lut.render.closures.RETRO_ROUGHNESS``) and Metallic BSDF IORs.
 ROUGHNESS = (0.05, 0.1, 0.2, 0.3, 0.45, 0.6, 0.8, 1.0)
 IORS = (1.33, 1.5, 1.7, 2.0)
 #: Kinds with tables (the closure kinds an EEVEE fit may use).
@@ -127,7 +127,7 @@ def fill(ratio):
 
 def encode(tables: dict) -> str:
     """A version's tables ({key: (θl, θv, φ) ratio}) as the text stored in
-    ``lut/eevee_tables.py``: a compressed .npz (float16), base64."""
+    ``lut/render/eevee_tables.py``: a compressed .npz (float16), base64."""
     buf = io.BytesIO()
     np.savez_compressed(buf, **{k: np.asarray(v, dtype=np.float16) for k, v in tables.items()})
     return base64.b64encode(buf.getvalue()).decode("ascii")

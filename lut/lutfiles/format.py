@@ -1,12 +1,12 @@
 """Paint LUT files: OpenEXR images written and read with OpenImageIO, or
-without it by lut.exr (numpy; Blender 4.2-4.3 ship no OpenImageIO module).
+without it by lut.lutfiles.exr (numpy; Blender 4.2-4.3 ship no OpenImageIO module).
 
 Layout (format version 2).  A float32 three-channel image of width N_u and
 height T · N_φd · N_θd: T tiles (meta "tiles": 1, or 3 for a dispersive
 paint, one per RGB channel) of N_φd blocks of (θh, θd) stacked vertically.
 Pixel (x, y) of tile t holds, in its channels, G = f · cos θi · cos θs
-(``lut.table``) of the components (meta "components": facet, single,
-diffuse; ``lut.baking``) at u = x / (N_u - 1),
+(``lut.lutfiles.table``) of the components (meta "components": facet, single,
+diffuse; ``lut.lutfiles.baking``) at u = x / (N_u - 1),
 θd = (y' mod N_θd) / (N_θd - 1) · π/2 and φd = (y' div N_θd) / (N_φd - 1) · π/2,
 y' = y - t · N_φd · N_θd.  The values are data, not colour: read them as
 Non-Color.
@@ -47,7 +47,7 @@ class LUTError(ValueError):
 
 
 def _oiio():
-    """The OpenImageIO module, or None: then ``lut.exr`` (numpy) reads and
+    """The OpenImageIO module, or None: then ``lut.lutfiles.exr`` (numpy) reads and
     writes the files.  Inside Blender 4.4+ the add-on layer makes Blender's
     bundled module importable first (bpy.utils.expose_bundled_modules());
     Blender 4.2-4.3 have none.  ``lut`` itself never imports bpy."""
@@ -60,7 +60,7 @@ def _oiio():
 
 def _write_image(path, image, attributes):
     """Write an RGB float image with attributes (OpenImageIO, ZIP
-    compressed; or uncompressed through lut.exr)."""
+    compressed; or uncompressed through lut.lutfiles.exr)."""
     oiio = _oiio()
     if oiio is None:
         exr.write(path, image, ("R", "G", "B"), attributes)

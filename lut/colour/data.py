@@ -1,7 +1,7 @@
 """Colour data for lut, computed with colour-science 0.4.6 by scripts/make_colour_data.py (do not edit).
 
 SPECTRAL_WEIGHTS[space]: the (3, 81) matrix of
-lut.colour_management.compute_spectral_weights (CIE 1931 2 degree observer,
+lut.colour.management.compute_spectral_weights (CIE 1931 2 degree observer,
 D65, 380-780 nm in 5 nm steps, Bradford to the working space).
 RGB_TO_RGB['A -> B']: colour-science's matrix_RGB_to_RGB with Bradford.
 SPECTRA['collection/name']: (wavelengths nm, values) of colour-science's

@@ -14,7 +14,7 @@ stack of layers, each attenuating the ones below by its estimated albedo
 * coat (weight w_c, roughness r_c, IOR n_c): GGX reflection of α = r_c² with
   exact dielectric Fresnel, F·D·G/(4 cos θv) per unit irradiance (Walter et
   al., "Microfacet models for refraction through rough surfaces", EGSR 2007,
-  Eqs. 33-34; ``lut.closures``' "ggx" kind), times w_c;
+  Eqs. 33-34; ``lut.render.closures``' "ggx" kind), times w_c;
 * specular (roughness r, IOR n): the same lobe at α = r², under the coat;
 * diffuse: Lambert, base colour · cos θl/π, under both.
 
@@ -32,7 +32,7 @@ Heitz, "Sampling the GGX distribution of visible normals", JCGT 7(4), 2018,
 Eq. 1) and read with the same interpolation.
 
 The fit (``fit_principled``) minimizes the acceptance error
-(``lut.fitting.ACCEPTANCE_GRID``: cos-weighted relative RMS of f·cos θl over
+(``lut.render.fitting.ACCEPTANCE_GRID``: cos-weighted relative RMS of f·cos θl over
 θl, θv ≤ 75°, off the mirror): the base colour is linear in the radiance and
 solved in closed form per channel (clipped to [0, 1]); roughness, IOR and
 the coat's parameters by Nelder-Mead from the best point of a coarse grid.
@@ -45,9 +45,9 @@ import functools
 
 import numpy as np
 
+from ..models import _validate
 from .closures import Closure, _ggx
 from .fitting import ACCEPTANCE_GRID
-from .models import _validate
 
 #: Bounds of the fitted parameters (the Principled node's own ranges where it
 #: has them; IOR within what paints' binders and coats span, widened).
@@ -236,9 +236,9 @@ def _grid():
 
 def reference(source, amplitudes=None) -> np.ndarray:
     """f·cos θl of the paint on the acceptance grid, (N, 3): ``source`` a
-    ``lut.Paint``, or a loaded LUT (``lut.baking.LUT``) with ``amplitudes``
+    ``lut.Paint``, or a loaded LUT (``lut.lutfiles.baking.LUT``) with ``amplitudes``
     (3 channels × 3 components, ``Paint.amplitudes`` or
-    ``render.amplitudes_of_inputs``)."""
+    ``lut.render.bake.amplitudes_of_inputs``)."""
     tl, tv, ph = _grid()
     if hasattr(source, "brdf"):
         if amplitudes is not None:
