@@ -278,29 +278,107 @@ def _oren_nayar(closure, theta_l, theta_v, phi):
     return np.where(up, cl * (a + b * t + e_ms * (1.0 - e_v) * (1.0 - e_l)), 0.0)
 
 
+# ---------------------------------------------------------------------- EEVEE's rendering
+
+#: The roughnesses (glossy, metallic) and Metallic BSDF IORs at which EEVEE's
+#: rendering of the lobes is calibrated (``lut.render.eevee``); the retro GGX
+#: lobes at ``RETRO_ROUGHNESS``.
+EEVEE_ROUGHNESS = (0.05, 0.1, 0.2, 0.3, 0.45, 0.6, 0.8, 1.0)
+EEVEE_IORS = (1.33, 1.5, 1.7, 2.0)
+#: Roughnesses of the retro GGX lobes an EEVEE fit of a smooth type may use.
+RETRO_ROUGHNESS = (0.45, 0.6, 0.8, 1.0)
+
+
+def _eevee_lambert(closure, theta_l, theta_v, phi):
+    """cos θl/π: EEVEE draws the Diffuse BSDF of any roughness and the Sheen BSDF as Lambert."""
+    return np.where(theta_l < np.pi / 2, np.cos(theta_l), 0.0) / np.pi
+
+
+def _eevee_retro_toon(closure, theta_l, theta_v, phi):
+    """max(0, l·v)/π: EEVEE draws a Toon closure as Lambert about its normal
+    (here the view direction), whatever its size and smooth, and does not
+    clip the light at the surface's horizon."""
+    return np.maximum(np.cos(light_view_angle(theta_l, theta_v, phi)), 0.0) / np.pi
+
+
+def _eevee_glossy(closure, theta_l, theta_v, phi):
+    """The GGX lobe D·G/(4 cos θv) of α = r², height-correlated Smith G
+    (Walter et al. 2007, Eqs. 33-34), no Fresnel: EEVEE draws Beckmann lobes as GGX."""
+    return ggx_lobe(theta_l, theta_v, phi, closure.roughness)[0]
+
+
+def _eevee_metallic(closure, theta_l, theta_v, phi):
+    """The GGX lobe times the exact unpolarized dielectric Fresnel
+    reflectance at the half vector, F(θd, n) (``lut.models.fresnel``)."""
+    lobe, cos_d = ggx_lobe(theta_l, theta_v, phi, closure.roughness)
+    rs, rp = fresnel.reflection_coefficients(cos_d, closure.ior)
+    return lobe * 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)
+
+
+def _eevee_retro_glossy(closure, theta_l, theta_v, phi):
+    """Its Cycles formula: the GGX lobe in the frame of the view direction."""
+    return _retro_glossy(closure, theta_l, theta_v, phi)
+
+
+@dataclasses.dataclass(frozen=True)
+class EeveeResponse:
+    """How EEVEE's rendering of a closure kind is calibrated
+    (``lut.render.eevee``): the smooth analytic ``reference`` its measured
+    ratio tables correct, the closure parameters a table is measured at
+    (``params``: they name it, ``table_key``), and for each parameter
+    interpolated between tables its calibrated values (``grids``).  A kind
+    with parameters but no grids has tables that EEVEE renders alike (its
+    diffuse closures): their mean is used for any parameter."""
+
+    reference: object
+    params: tuple = ()
+    grids: dict = dataclasses.field(default_factory=dict)
+
+
 @dataclasses.dataclass(frozen=True)
 class ClosureKind:
-    """A registered closure kind: its evaluation, whether it is grey, and
-    its render cost in closures (an Oren-Nayar closure is one per channel)."""
+    """A registered closure kind: its evaluation (Cycles' formula), whether
+    it is grey, its render cost in closures (an Oren-Nayar closure is one
+    per channel), whether EEVEE counts it as a reflection closure (its
+    microfacet lobes; ``lut.render.eevee.EXACT_REFLECTION_CLOSURES``) and how
+    EEVEE's rendering of it is calibrated (``eevee``; None: an EEVEE fit
+    never uses it)."""
 
     evaluate: object
     grey: bool = False
     cost: int = 1
+    reflection: bool = False
+    eevee: EeveeResponse | None = None
 
+
+_DIFFUSE_EEVEE = EeveeResponse(_eevee_lambert)
 
 #: The closure kinds the fit and the node groups know (colour-science style
-#: registry: ``lut.render.fitting`` evaluates them, ``addon.nodes`` builds them).
+#: registry: ``lut.render.fitting`` evaluates them, ``lut.render.eevee`` reads
+#: EEVEE's calibration of them, ``addon.nodes`` builds them): a new kind is
+#: added here alone.
 CLOSURE_KINDS = {
-    "lambert": ClosureKind(_lambert),
+    "lambert": ClosureKind(_lambert, eevee=_DIFFUSE_EEVEE),
     "diffuse_toon": ClosureKind(_diffuse_toon),
     "glossy_toon": ClosureKind(_glossy_toon),
-    "retro_toon": ClosureKind(_retro_toon),
-    "glossy": ClosureKind(_glossy),
-    "sheen": ClosureKind(_sheen),
-    "oren_nayar": ClosureKind(_oren_nayar, cost=3),
-    "metallic": ClosureKind(_metallic, grey=True),
-    "ggx": ClosureKind(_ggx, grey=True),
-    "retro_glossy": ClosureKind(_retro_glossy),
+    "retro_toon": ClosureKind(_retro_toon, eevee=EeveeResponse(_eevee_retro_toon, ("size", "smooth"))),
+    "glossy": ClosureKind(
+        _glossy, reflection=True, eevee=EeveeResponse(_eevee_glossy, ("roughness",), {"roughness": EEVEE_ROUGHNESS})
+    ),
+    "sheen": ClosureKind(_sheen, eevee=EeveeResponse(_eevee_lambert, ("roughness",))),
+    "oren_nayar": ClosureKind(_oren_nayar, cost=3, eevee=EeveeResponse(_eevee_lambert, ("roughness",))),
+    "metallic": ClosureKind(
+        _metallic,
+        grey=True,
+        reflection=True,
+        eevee=EeveeResponse(_eevee_metallic, ("ior", "roughness"), {"ior": EEVEE_IORS, "roughness": EEVEE_ROUGHNESS}),
+    ),
+    "ggx": ClosureKind(_ggx, grey=True, reflection=True),
+    "retro_glossy": ClosureKind(
+        _retro_glossy,
+        reflection=True,
+        eevee=EeveeResponse(_eevee_retro_glossy, ("roughness",), {"roughness": RETRO_ROUGHNESS}),
+    ),
 }
 
 
@@ -349,11 +427,6 @@ def _lobes(type_dict, exact_metallic):
     rough = lobe_roughnesses(slope, type_dict["distribution"])
     grey = "metallic" if exact_metallic else "ggx"
     return [Closure(grey, ior=n, roughness=r) for r in rough] + [Closure("glossy", roughness=r) for r in rough]
-
-
-#: Roughnesses of the retro GGX lobes an EEVEE fit of a smooth type may use
-#: (calibrated in ``lut.render.eevee``).
-RETRO_ROUGHNESS = (0.45, 0.6, 0.8, 1.0)
 
 
 def candidates(type_dict: dict, target: str = "CYCLES", exact_metallic: bool = True) -> list:

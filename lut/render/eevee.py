@@ -10,22 +10,11 @@ a grid of (θl, θv, |φ|) (``THETA``, ``PHI``) in ``lut/render/eevee_tables.py`
 contract as ``Closure.evaluate`` (contribution per unit irradiance, cos θl
 included; light at azimuth π, φ = 0 the mirror direction).
 
-The references (what EEVEE was found to approximate):
-
-* ``lambert``, ``oren_nayar``, ``sheen``: cos θl/π (EEVEE 5.0 draws the
-  Diffuse BSDF of any roughness and the Sheen BSDF as Lambert).
-* ``retro_toon``: max(0, l·v)/π, Lambert about the Toon's normal (the view
-  direction): EEVEE draws Toon closures as Lambert, whatever their size and
-  smooth, and does not clip the light at the surface's horizon.
-* ``glossy``: the GGX lobe D·G/(4 cos θv) of α = r² with the
-  height-correlated Smith G (Walter et al., "Microfacet models for
-  refraction through rough surfaces", EGSR 2007, Eqs. 33-34), no Fresnel:
-  EEVEE draws Beckmann lobes as GGX.
-* ``metallic``: the same times the exact unpolarized dielectric Fresnel
-  reflectance at the half vector, F(θd, n) (``lut.models.fresnel``).
-* ``retro_glossy``: the GGX lobe in the frame of its normal, the view
-  direction (``lut.render.closures``: viewer at θv' = 0, light at the angle γ
-  between l and v).
+Each kind's reference (what EEVEE was found to approximate: Lambert for its
+diffuse closures, GGX for its microfacet lobes), the parameters its tables
+are measured at and their calibrated values are the kind's ``eevee`` entry
+in the closure registry (``lut.render.closures.CLOSURE_KINDS``): a new kind
+is added there alone.
 
 Between the calibrated roughnesses ``ROUGHNESS`` (and IORs ``IORS`` of the
 Metallic BSDF) the ratio tables are interpolated linearly, the reference
@@ -39,18 +28,17 @@ import io
 
 import numpy as np
 
-from ..models import fresnel
-from .closures import RETRO_ROUGHNESS, Closure, ggx_lobe, light_view_angle
+from .closures import CLOSURE_KINDS, EEVEE_IORS, EEVEE_ROUGHNESS, Closure
 
 #: The grid of the tables: θl and θv in 5° steps to 90°, |φ| in 15° steps.
 THETA = np.radians(np.arange(0.0, 90.1, 5.0))
 PHI = np.radians(np.arange(0.0, 180.1, 15.0))
-#: Calibrated roughnesses (glossy, metallic; the retro GGX lobes at
-#: ``lut.render.closures.RETRO_ROUGHNESS``) and Metallic BSDF IORs.
-ROUGHNESS = (0.05, 0.1, 0.2, 0.3, 0.45, 0.6, 0.8, 1.0)
-IORS = (1.33, 1.5, 1.7, 2.0)
-#: Kinds with tables (the closure kinds an EEVEE fit may use).
-KINDS = ("lambert", "oren_nayar", "sheen", "retro_toon", "glossy", "metallic", "retro_glossy")
+#: Calibrated roughnesses and Metallic BSDF IORs (``lut.render.closures``).
+ROUGHNESS = EEVEE_ROUGHNESS
+IORS = EEVEE_IORS
+#: Kinds with tables (the closure kinds an EEVEE fit may use): those the
+#: closure registry gives an EEVEE response.
+KINDS = tuple(kind for kind, spec in CLOSURE_KINDS.items() if spec.eevee is not None)
 
 #: What EEVEE (Blender 5.0, one sample per pixel) sums exactly, measured by
 #: scripts/eevee_additivity.py: diffuse closures sharing the surface normal
@@ -64,38 +52,23 @@ EXACT_DIFFUSE_NORMALS = 1
 EXACT_REFLECTION_CLOSURES = 2
 
 
+def _response(closure: Closure):
+    response = CLOSURE_KINDS[closure.kind].eevee
+    if response is None:
+        raise ValueError(f"EEVEE has no calibration of closure kind {closure.kind!r} (calibrated: {', '.join(KINDS)})")
+    return response
+
+
 def table_key(closure: Closure) -> str:
     """The table of a calibrated closure: its kind and the parameters EEVEE's
-    rendering of it was measured over."""
-    if closure.kind == "metallic":
-        return f"metallic/{closure.ior:g}/{closure.roughness:g}"
-    if closure.kind in ("glossy", "oren_nayar", "sheen", "retro_glossy"):
-        return f"{closure.kind}/{closure.roughness:g}"
-    if closure.kind == "retro_toon":
-        return f"retro_toon/{closure.size:g}/{closure.smooth:g}"
-    return closure.kind
-
-
-# ---------------------------------------------------------------------- references
+    rendering of it was measured at (``EeveeResponse.params``)."""
+    return "/".join([closure.kind, *(f"{getattr(closure, p):g}" for p in _response(closure).params)])
 
 
 def reference(closure: Closure, theta_l, theta_v, phi):
-    """The analytic model a kind's table corrects (module docstring)."""
+    """The analytic model a kind's table corrects (``EeveeResponse.reference``)."""
     theta_l, theta_v, phi = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (theta_l, theta_v, phi)))
-    kind = closure.kind
-    if kind in ("lambert", "oren_nayar", "sheen"):
-        return np.where(theta_l < np.pi / 2, np.cos(theta_l), 0.0) / np.pi
-    if kind == "retro_toon":
-        return np.maximum(np.cos(light_view_angle(theta_l, theta_v, phi)), 0.0) / np.pi
-    if kind == "retro_glossy":  # its Cycles formula is the GGX lobe about the view
-        return closure.evaluate(theta_l, theta_v, phi)
-    if kind in ("glossy", "metallic"):
-        lobe, cos_d = ggx_lobe(theta_l, theta_v, phi, closure.roughness)
-        if kind == "glossy":
-            return lobe
-        rs, rp = fresnel.reflection_coefficients(cos_d, closure.ior)
-        return lobe * 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)
-    raise ValueError(f"EEVEE has no calibration of closure kind {kind!r} (calibrated: {', '.join(KINDS)})")
+    return _response(closure).reference(closure, theta_l, theta_v, phi)
 
 
 # ---------------------------------------------------------------------- tables
@@ -202,25 +175,19 @@ def _bracket(values, x):
 def ratio(closure: Closure, theta_l, theta_v, phi, version=(5, 0)):
     """EEVEE's radiance over ``reference`` for ``closure``, interpolated."""
     data = tables(version)
-    kind = closure.kind
-    if kind in ("lambert", "oren_nayar", "sheen"):
-        keys = {k: 1.0 for k in data if k == kind or k.startswith(kind + "/")}
-    elif kind == "retro_toon":
-        keys = {k: 1.0 for k in data if k.startswith("retro_toon/")}
-    elif kind in ("glossy", "retro_glossy"):
-        lo, hi, t = _bracket(ROUGHNESS if kind == "glossy" else RETRO_ROUGHNESS, closure.roughness)
-        keys = {f"{kind}/{lo:g}": 1.0 - t}
-        keys[f"{kind}/{hi:g}"] = keys.get(f"{kind}/{hi:g}", 0.0) + t
-    elif kind == "metallic":
-        r_lo, r_hi, t = _bracket(ROUGHNESS, closure.roughness)
-        n_lo, n_hi, s = _bracket(IORS, closure.ior)
-        keys = {}
-        for n, wn in ((n_lo, 1.0 - s), (n_hi, s)):
-            for r, wr in ((r_lo, 1.0 - t), (r_hi, t)):
-                key = f"metallic/{n:g}/{r:g}"
-                keys[key] = keys.get(key, 0.0) + wn * wr
-    else:
-        raise ValueError(f"EEVEE has no calibration of closure kind {kind!r} (calibrated: {', '.join(KINDS)})")
+    response, kind = _response(closure), closure.kind
+    if response.params and not response.grids:  # tables EEVEE renders alike: their mean
+        keys = {k: 1.0 for k in data if k.startswith(kind + "/")}
+    else:  # multilinear between the calibrated values of each gridded parameter
+        keys = {kind: 1.0}
+        for param in response.params:
+            lo, hi, t = _bracket(response.grids[param], getattr(closure, param))
+            grown = {}
+            for key, w in keys.items():
+                for value, wv in ((lo, 1.0 - t), (hi, t)):
+                    name = f"{key}/{value:g}"
+                    grown[name] = grown.get(name, 0.0) + w * wv
+            keys = grown
     if not keys or any(k not in data for k in keys):
         raise ValueError(f"the Blender {_version_key(version)} tables lack {kind!r}")
     total = sum(keys.values())
@@ -232,8 +199,7 @@ def evaluate(closure: Closure, theta_l, theta_v, phi, version=(5, 0)):
     included (``Closure.evaluate``'s contract, as EEVEE renders it on
     Blender line ``version``): reference × interpolated ratio.  Raises
     ValueError for a kind not in ``KINDS`` or a version without tables."""
-    if closure.kind not in KINDS:
-        raise ValueError(f"EEVEE has no calibration of closure kind {closure.kind!r} (calibrated: {', '.join(KINDS)})")
+    _response(closure)
     theta_l, theta_v, phi = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (theta_l, theta_v, phi)))
     value = reference(closure, theta_l, theta_v, phi) * ratio(closure, theta_l, theta_v, phi, version)
     up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2)
@@ -253,4 +219,4 @@ def calibration_for(blender_version):
 def is_reflection(closure: Closure) -> bool:
     """Whether EEVEE counts the closure as a reflection closure (its
     microfacet lobes) rather than a diffuse one (``EXACT_REFLECTION_CLOSURES``)."""
-    return closure.kind in ("glossy", "metallic", "ggx", "retro_glossy")
+    return CLOSURE_KINDS[closure.kind].reflection
