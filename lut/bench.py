@@ -9,7 +9,7 @@ import numpy as np
 
 from . import models
 from .models import reference
-from .render import fitting
+from .render import measure
 
 CLOSED_FORM = {
     "facet_reflection": (models.facet_reflection, {"n": 1.5, "slope": 0.3}),
@@ -280,29 +280,20 @@ def render_bake_times(paints, directory, repeat=1, eevee_calibration=(5, 0)):
     return rows
 
 
-#: Bins of the dense fidelity measure (``binned_error``): θl and θv in 5°
-#: steps up to 75° (the acceptance measure's range), |φ| in 15° steps from
-#: 20° (away from the mirror direction, as the acceptance grid is).
-BIN_THETA = np.radians(np.arange(0.0, 75.1, 5.0))
-BIN_PHI = np.radians(np.arange(20.0, 180.1, 15.0))
-
-
 #: Samples nearer the mirror direction than this are left out of
-#: ``binned_error``, as the acceptance grid's nearest point (θl = 0, θv =
-#: 5°) is this far from it (the fit's dense measure leaves out the same).
-MIRROR_DISTANCE = fitting.MIRROR_EXCLUSION
-mirror_distance = fitting.mirror_distance
+#: ``binned_error`` for a smooth paint (the fidelity measure's exclusion).
+MIRROR_DISTANCE = measure.MIRROR_EXCLUSION
+mirror_distance = measure.mirror_distance
 
 
-def binned_error(theta_l, theta_v, phi, rendered, model, min_pixels=3):
-    """The acceptance measure on pixel samples of any geometry (e.g. the
-    pixels of spheres under a sun, each its own (θl, θv, φ)): the samples are
-    binned on (θl, θv, |φ|) (``BIN_THETA``, ``BIN_PHI``; bin centres at the
-    nodes), each bin's mean rendered and model radiance compared, and the
-    bins weighted by cos θl as the acceptance measure weights its grid
-    points (samples within ``MIRROR_DISTANCE`` of the mirror direction left
-    out, as the grid stays that far from it):
-    sqrt(Σ cos²θl·|mean rendered − mean model|² / Σ cos²θl·|mean model|²)
+def binned_error(theta_l, theta_v, phi, rendered, model, min_pixels=3, smooth=True):
+    """The fidelity measure (``lut.render.measure``) on pixel samples of any
+    geometry (e.g. the pixels of spheres under a sun, each its own (θl, θv,
+    φ)): the samples are binned on the measure's grid (bin centres at its
+    geometries; ``smooth``: samples within ``MIRROR_DISTANCE`` of the mirror
+    direction left out), each bin's mean rendered and model radiance
+    compared, every bin counted once:
+    sqrt(Σ |mean rendered − mean model|² / Σ |mean model|²)
     over bins with at least ``min_pixels`` samples, all channels.
     ``rendered`` and ``model`` are radiances (N, 3) per unit irradiance
     (f·cos θl).  Returns (error, bins used)."""
@@ -310,28 +301,26 @@ def binned_error(theta_l, theta_v, phi, rendered, model, min_pixels=3):
     rendered = np.asarray(rendered, dtype=float).reshape(theta_l.size, -1)
     model = np.asarray(model, dtype=float).reshape(theta_l.size, -1)
     ph = np.abs(phi)
-    step_t, step_p = BIN_THETA[1] - BIN_THETA[0], BIN_PHI[1] - BIN_PHI[0]
-    inside = (
-        (theta_l <= BIN_THETA[-1] + step_t / 2)
-        & (theta_v <= BIN_THETA[-1] + step_t / 2)
-        & (ph >= BIN_PHI[0] - step_p / 2)
-        & (mirror_distance(theta_l, theta_v, phi) >= MIRROR_DISTANCE)
-    )
-    il = np.clip(np.rint(theta_l / step_t), 0, BIN_THETA.size - 1).astype(int)
-    iv = np.clip(np.rint(theta_v / step_t), 0, BIN_THETA.size - 1).astype(int)
-    ip = np.clip(np.rint((ph - BIN_PHI[0]) / step_p), 0, BIN_PHI.size - 1).astype(int)
-    shape = (BIN_THETA.size, BIN_THETA.size, BIN_PHI.size)
-    flat = np.ravel_multi_index((il, iv, ip), shape)[inside]
+    axes = measure.GRID
+    steps = [a[1] - a[0] for a in axes]
+    inside = np.ones(theta_l.shape, dtype=bool)
+    index = []
+    for value, axis, step in zip((theta_l, theta_v, ph), axes, steps, strict=True):
+        inside &= (value >= axis[0] - step / 2) & (value <= axis[-1] + step / 2)
+        index.append(np.clip(np.rint((value - axis[0]) / step), 0, axis.size - 1).astype(int))
+    if smooth:
+        inside &= mirror_distance(theta_l, theta_v, phi) >= MIRROR_DISTANCE
+    shape = tuple(a.size for a in axes)
+    flat = np.ravel_multi_index(tuple(index), shape)[inside]
     size = int(np.prod(shape))
     count = np.bincount(flat, minlength=size)
     used = count >= min_pixels
     if not used.any():
         raise ValueError("no bin of the measure holds enough samples")
-    weight = np.cos(BIN_THETA)[np.unravel_index(np.arange(size), shape)[0]][used]
     num = den = 0.0
     for c in range(rendered.shape[1]):
         got = np.bincount(flat, rendered[inside, c], size)[used] / count[used]
         want = np.bincount(flat, model[inside, c], size)[used] / count[used]
-        num += np.sum((weight * (got - want)) ** 2)
-        den += np.sum((weight * want) ** 2)
+        num += np.sum((got - want) ** 2)
+        den += np.sum(want**2)
     return float(np.sqrt(num / den)), int(used.sum())

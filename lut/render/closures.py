@@ -413,7 +413,9 @@ def lobe_roughnesses(slope: float, distribution: str) -> list[float]:
     Beckmann lobe) and neighbours; for exponential slopes, whose sharper peak
     and longer tail no single Beckmann lobe has, a ladder from a fifth to
     three times the slope (a mixture of Beckmann lobes)."""
-    factors = (0.5, 0.7, 1.0, 1.4, 2.0) if distribution == "gaussian" else (0.2, 0.35, 0.6, 1.0, 1.6, 2.5, 3.5)
+    factors = (
+        (0.5, 0.7, 1.0, 1.4, 2.0) if distribution == "gaussian" else (0.05, 0.1, 0.2, 0.35, 0.6, 1.0, 1.6, 2.5, 3.5)
+    )
     rough = np.sqrt(np.clip(slope * np.asarray(factors), 1e-4, 1.0))
     return [float(r) for r in np.unique(np.round(rough, 4))]
 

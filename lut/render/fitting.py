@@ -11,17 +11,21 @@ The fit, per render target (``fit_lut``):
 
 1. Rows.  For each of M view cosines, light directions on a grid of half
    vectors around the normal (θh = π/2·u², dense near the mirror, where
-   facet lobes are sharp), reflected about the view; each row weighted by
-   its solid angle (dω_l = 4 (h·v) dω_h) and by cos θl, as the acceptance
-   measure weights radiance.  Targets come from the LUT, never the model.
+   facet lobes are sharp), reflected about the view, up to lights
+   ``MAX_LIGHT`` from the normal (past the measure's 75°, so the fall-off
+   toward the horizon is fitted, not extrapolated); each row is radiance
+   L = f·cos θl weighted by its share of the fidelity measure
+   (``lut.render.measure``: uniform in θl and φ, dθl dφ = dω/sin θl with
+   dω_l = 4 (h·v) dω_h) and nothing further.  Targets come from the LUT.
 2. Selection.  Forward selection: from the target's candidate closures,
    repeatedly add the one that most reduces the sum over components of the
-   squared relative error (ranked by least squares over all views at once,
+   squared relative error on the measure, views weighted by their share of
+   it (uniform in θv) (ranked by least squares over all views at once,
    the best few checked by non-negative least squares, all of them when
    none of those helps: near-collinear Toon ramps mislead the
    unconstrained ranking), until the render
    cost budget (closures per material) is spent or the error is far below
-   target.  Where a component's error on the acceptance grid (step 4) is
+   target.  Where a component's error on the measure (step 4) is
    then still above the target (some colour of the type would miss it),
    the selection is made again with a few closures more (``EXTRA_BUDGET``)
    and kept if it lowers that error.  Grey closures (no colour input)
@@ -29,12 +33,13 @@ The fit, per render target (``fit_lut``):
    factor clamps there).
 3. Weights.  Non-negative least squares per view and component over the
    chosen closures (``lut.render.nnls``).
-4. Error.  On the acceptance grid (θl, θv <= 75°, azimuths off the mirror)
-   and on a dense grid of the same range (``DENSE_GRID``): the closures
-   with their weights interpolated linearly in cos θv, against the LUT.
-   Stored as Gram matrices of the residuals and targets per component, so
-   the cos-weighted relative RMS of any colour, the larger of the two
-   grids', is ``Fit.error(amplitudes)``: the panel shows it live.
+4. Error.  The fidelity measure (``lut.render.measure``), whole and over
+   the grazing band: the closures, with the weights the node group reads
+   (the texture's nearest column), against the paper's model itself (not
+   the LUT), at every geometry of the measure's grid.  Stored as Gram
+   matrices of the residuals and targets per component, so the error of
+   any colour is ``Fit.error(amplitudes)`` (``Fit.grazing_error``): the
+   panel shows it live.
 
 The weights file (``write_fit``) is a Non-Color float EXR with one row per
 (closure, component) pair in use and ``TEXTURE_VIEWS`` columns (the fitted
@@ -54,40 +59,18 @@ import numpy as np
 
 from ..lutfiles import format as lutfile
 from ..paint.core import COMPONENTS, reference_index
-from . import closures
+from . import closures, measure
 from .closures import Closure
 from .nnls import nnls_gram_batch
 
 #: Fit format version: bumped when the weights file layout or the fit changes.
 #: It is part of the weights file's name (``fit_path``), so a new release
 #: never overwrites a file that an older release's node groups still read.
-FIT_VERSION = 6
+FIT_VERSION = 7
 
-#: The acceptance measure's geometries: θl, θv <= 75° and azimuths away from
-#: the exact mirror direction (φ = 0); the Cycles oracle tests use the same.
-ACCEPTANCE_GRID = (
-    np.radians([0.0, 15.0, 30.0, 45.0, 60.0, 75.0]),
-    np.radians([5.0, 20.0, 35.0, 50.0, 65.0, 75.0]),
-    np.array([0.4, 1.1, 1.9, 2.6, 3.1]),
-)
-
-#: The dense measure the fit's reported error also covers: θl 0-75° and
-#: θv 5-75° in 5° steps, azimuths 20-180° in 10° steps, less the points
-#: within 5° of the mirror direction (the acceptance grid's own distance
-#: from it).  Between the acceptance grid's points a lobe a few degrees wide
-#: can be far off unseen: EEVEE's sharp GGX lobes, fitted to 9-11% there,
-#: are 19-21% off here.
-DENSE_GRID = (
-    np.radians(np.arange(0.0, 75.1, 5.0)),
-    np.radians(np.arange(5.0, 75.1, 5.0)),
-    np.radians(np.arange(20.0, 180.1, 10.0)),
-)
-MIRROR_EXCLUSION = np.radians(5.0)
-
-#: Targets of the acceptance error (cos-weighted relative RMS): smooth and
-#: rough types, per render target.  EEVEE's are its own (it approximates
-#: every closure).
-TARGET_ERROR = {"CYCLES": {"smooth": 0.02, "rough": 0.05}, "EEVEE": {"smooth": 0.03, "rough": 0.08}}
+#: Goals of the fidelity measure (whole domain) per engine and kind of
+#: paint (``lut.render.measure.GOALS``; the grazing band's are twice these).
+TARGET_ERROR = {e: {k: g[0] for k, g in kinds.items()} for e, kinds in measure.GOALS.items()}
 
 #: Closures per material (render cost grows with their number; the mirror
 #: of a smooth type comes on top).  EEVEE evaluates few closures per pixel.
@@ -113,14 +96,15 @@ TEXTURE_VIEWS = VIEW_SUBDIVISION * (VIEWS - 1) + 1
 LIGHT_GRID = (24, 24)
 #: sin θl below which a row's measure dθl dφ = dω/sin θl is not raised further.
 MIN_SIN = np.sin(np.radians(5.0))
-#: Lights beyond this polar angle are not fitted (their cos θl weight is nil).
-MAX_LIGHT = np.radians(88.0)
+#: Lights are fitted up to this polar angle: the measure's 75° and a margin,
+#: so the fit follows the light-side fall-off to where the measure ends.
+MAX_LIGHT = np.radians(85.0)
 #: Views are evaluated at most this far from the normal (θv = 90° exactly is
 #: a degenerate direction).
 MAX_VIEW = np.radians(89.5)
 
-#: Views up to this polar angle drive the selection fully (the acceptance
-#: measure's range and a margin); views beyond count a tenth.
+#: Views up to this polar angle drive the selection fully (the measure's
+#: range and a margin); views beyond count a tenth.
 SELECTION_VIEW = np.radians(80.0)
 
 _CANDIDATES_CHECKED = 4
@@ -134,10 +118,10 @@ class Fit:
     weights    (K, C, M, T): w_kc at view cosines ``cos_view`` (M), per tile
                T (1, or 3 for a dispersive type: one per RGB channel)
     residual   (T, C, C) and ``reference`` (T, C, C): Gram matrices of the
-               fit's residual and of the LUT's components on the acceptance
-               grid (cos-weighted), giving ``error`` for any colour
-    dense_residual, dense_reference: the same on ``DENSE_GRID`` (None for
-               a fit made without them)
+               rendered radiance's residual and of the model's radiance per
+               component on the fidelity measure's grid
+               (``lut.render.measure``), giving ``error`` for any colour
+    grazing_residual, grazing_reference: the same over the grazing band
     mirror     whether the type has a smooth interface's mirror (a delta,
                rendered by a mirror closure of weight ``Surface Reflection``)
     """
@@ -155,16 +139,21 @@ class Fit:
     internal_reflectance: float
     lut_key: str = ""
     calibration: tuple | None = None
-    dense_residual: np.ndarray | None = None
-    dense_reference: np.ndarray | None = None
+    grazing_residual: np.ndarray | None = None
+    grazing_reference: np.ndarray | None = None
 
     @property
     def rough(self) -> bool:
         return float(self.type["slope"]) > 0
 
     @property
+    def goals(self) -> tuple[float, float]:
+        """(whole, grazing band) goals of the measure for this fit."""
+        return measure.goals(self.target, not self.rough)
+
+    @property
     def target_error(self) -> float:
-        return TARGET_ERROR[self.target]["rough" if self.rough else "smooth"]
+        return self.goals[0]
 
     @property
     def rows(self) -> list:
@@ -178,24 +167,24 @@ class Fit:
         return component_errors(self.residual, self.reference)
 
     def error(self, amplitudes) -> float:
-        """Cos-weighted relative RMS of a paint with these amplitudes ((3
-        channels, 3 components): ``Paint.amplitudes``): the larger of its
-        values on the acceptance grid and on ``DENSE_GRID``, so neither a
-        grid point nor a lobe between the grid's points is seen better
-        than it renders."""
+        """The fidelity measure (``lut.render.measure``) of a paint with these
+        amplitudes ((3 channels, 3 components): ``Paint.amplitudes``), as the
+        node group renders it against the paper's model."""
         return reported_error(self.grams(), amplitudes)
 
+    def grazing_error(self, amplitudes) -> float:
+        """The same over the grazing band (θl ≥ 60°)."""
+        return reported_errors(self.grams(), amplitudes)[1]
+
     def grams(self) -> dict:
-        """The Gram matrices the reported error comes from, as lists (what a
-        material stores to show its error for any colour): residual,
-        reference, dense_residual and dense_reference (None without them)."""
-        dense = self.dense_residual is not None
-        return {
-            "residual": self.residual.tolist(),
-            "reference": self.reference.tolist(),
-            "dense_residual": self.dense_residual.tolist() if dense else None,
-            "dense_reference": self.dense_reference.tolist() if dense else None,
-        }
+        """The Gram matrices the reported errors come from, as lists (what a
+        material stores to show its errors for any colour): residual,
+        reference, grazing_residual and grazing_reference."""
+        out = {"residual": self.residual.tolist(), "reference": self.reference.tolist()}
+        for name in ("grazing_residual", "grazing_reference"):
+            value = getattr(self, name)
+            out[name] = None if value is None else value.tolist()
+        return out
 
     def header(self) -> dict:
         return {
@@ -217,8 +206,8 @@ class Fit:
 
 
 def component_errors(residual, reference) -> dict:
-    """{component: relative error of that component alone} from acceptance
-    Gram matrices (T, C, C), summed over tiles; None where it is nil."""
+    """{component: relative error of that component alone} from the
+    measure's Gram matrices (T, C, C), summed over tiles; None where it is nil."""
     out = {}
     for c, name in enumerate(COMPONENTS):
         ref = reference[:, c, c].sum()
@@ -226,17 +215,22 @@ def component_errors(residual, reference) -> dict:
     return out
 
 
+def reported_errors(grams: dict, amplitudes) -> tuple[float, float]:
+    """(whole, grazing band) fidelity measure of a colour from a fit's Gram
+    matrices (``Fit.grams``); the grazing figure is the whole one where the
+    grams lack the band."""
+    whole = gram_error(grams["residual"], grams["reference"], amplitudes)
+    if grams.get("grazing_residual") is None:
+        return whole, whole
+    return whole, gram_error(grams["grazing_residual"], grams["grazing_reference"], amplitudes)
+
+
 def reported_error(grams: dict, amplitudes) -> float:
-    """The error a fit reports for a colour (``Fit.error``) from its Gram
-    matrices (``Fit.grams``): the larger of the acceptance grid's and the
-    dense grid's (where the grams have it)."""
-    grid = acceptance_error(grams["residual"], grams["reference"], amplitudes)
-    if grams.get("dense_residual") is None:
-        return grid
-    return max(grid, acceptance_error(grams["dense_residual"], grams["dense_reference"], amplitudes))
+    """The fidelity measure a fit reports for a colour (``Fit.error``)."""
+    return reported_errors(grams, amplitudes)[0]
 
 
-def acceptance_error(residual, reference, amplitudes) -> float:
+def gram_error(residual, reference, amplitudes) -> float:
     """sqrt(Σ_ch aᵀRa / Σ_ch aᵀTa): the relative RMS of a colour (amplitudes
     a, (3 channels, C)) from the Gram matrices R of the residuals and T of
     the targets ((tiles, C, C): one tile for every channel, or one each)."""
@@ -290,8 +284,8 @@ def light_rows(theta_v, grid=LIGHT_GRID, max_light=MAX_LIGHT):
     (M, R).  Half vectors h at θh = π/2·u² (u at interval midpoints) and
     azimuths in [0, π] (the half with y < 0 mirrors it), reflected about
     the view v: l = 2(h·v)h - v, dω_l = 4(h·v) dω_h.  The weight is the
-    square root of dω_l times cos θl (the acceptance measure's weight on
-    radiance); rows below ``max_light`` have weight 0."""
+    square root of the row's share of the fidelity measure (uniform in θl
+    and φ); rows beyond ``max_light`` have weight 0."""
     n_u, n_phi = grid
     u = (np.arange(n_u) + 0.5) / n_u
     theta_h = 0.5 * np.pi * u * u
@@ -311,10 +305,10 @@ def light_rows(theta_v, grid=LIGHT_GRID, max_light=MAX_LIGHT):
     # The model puts the light at azimuth π: rotate the viewer (azimuth 0) with it.
     phi = np.pi - np.arctan2(np.where(ok, ly, 0.0), np.where(ok, lx, -1.0))
     phi = np.mod(phi + np.pi, 2 * np.pi) - np.pi
-    # The acceptance measure samples θl and φ uniformly, not solid angle:
+    # The fidelity measure samples θl and φ uniformly, not solid angle:
     # dθl dφ = dω / sin θl (bounded near the normal, where rows are few).
     d_measure = d_omega / np.maximum(np.sin(theta_l), MIN_SIN)
-    weight = np.where(ok, np.sqrt(d_measure) * np.cos(theta_l), 0.0)
+    weight = np.where(ok, np.sqrt(d_measure), 0.0)
     return theta_l, phi, weight
 
 
@@ -337,12 +331,24 @@ def _ls_errors(gram, rhs, norm, base, cands):
 
 
 def _relative(err, norm):
-    """The views' relative squared errors err/‖b‖², averaged with the views'
-    weights: every view counts by its relative error, as the acceptance
-    measure's views do, not by its radiance (which grows without bound
-    toward grazing views for rough facet terms)."""
-    rel = np.where(norm[:, 0] > 0, 1.0, 0.0) * norm[:, 1] / np.maximum(norm[:, 0], 1e-300)
-    return np.tensordot(rel, err, axes=(0, 0)) / max(float(np.sum(norm[:, 1] * (norm[:, 0] > 0))), 1e-300)
+    """The relative squared error over all views, Σ_v w_v·err_v / Σ_v
+    w_v·‖b_v‖², each view v weighted by its share w_v of the fidelity
+    measure (``view_measure``): the measure's own ratio, radiance residual
+    over radiance, summed over the geometries it counts.  err (M, ...);
+    norm (M, 2): each view's ‖b_v‖² and w_v."""
+    total = float(np.sum(norm[:, 0] * norm[:, 1]))
+    return np.tensordot(norm[:, 1], err, axes=(0, 0)) / max(total, 1e-300)
+
+
+def view_measure(theta_v):
+    """Each fitted view's share of the fidelity measure, which is uniform in
+    θv: the width in θv of the interval of view cosines it stands for, a
+    tenth beyond ``SELECTION_VIEW`` (outside the measure's range: fitted,
+    but not chosen for)."""
+    cos_v = np.cos(np.asarray(theta_v, dtype=float))
+    edges = np.concatenate(([cos_v[0]], 0.5 * (cos_v[1:] + cos_v[:-1]), [cos_v[-1]]))
+    width = np.abs(np.diff(np.arccos(np.clip(edges, -1.0, 1.0))))
+    return width * np.where(np.asarray(theta_v) <= SELECTION_VIEW, 1.0, 0.1)
 
 
 def _nnls_fit(gram, rhs, norm, idx, upper):
@@ -422,37 +428,57 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None):
 # ---------------------------------------------------------------------- fit
 
 
-def mirror_distance(theta_l, theta_v, phi):
-    """Angle between the view and the mirror direction of the light (light
-    at azimuth π, φ = 0 the mirror's azimuth)."""
-    cos = np.cos(theta_l) * np.cos(theta_v) + np.sin(theta_l) * np.sin(theta_v) * np.cos(phi)
-    return np.arccos(np.clip(cos, -1.0, 1.0))
+def texture_weights(weights, cos_view, cos_v):
+    """The weights (K, C, N, T) a node group reads at view cosines ``cos_v``
+    (N,) from a fit's weights at ``cos_view`` (M): the column of its weights
+    texture nearest to each cos θv (``texture_u``), the texture holding the
+    weights resampled linearly to ``texture_views(M)`` columns."""
+    columns = view_cosines(texture_views(len(cos_view)))
+    texture = resample_views(weights, cos_view, columns)
+    nearest = np.clip(np.rint(np.asarray(cos_v) * (len(columns) - 1)).astype(int), 0, len(columns) - 1)
+    return texture[:, :, nearest, :]
 
 
-def grid_points(grid=ACCEPTANCE_GRID, mirror_exclusion=0.0):
-    """The (θl, θv, φ) points of a grid's axes, flat, less those within
-    ``mirror_exclusion`` of the mirror direction."""
-    tl, tv, ph = (a.ravel() for a in np.meshgrid(*grid, indexing="ij"))
-    keep = mirror_distance(tl, tv, ph) >= mirror_exclusion
-    return tl[keep], tv[keep], ph[keep]
+@functools.lru_cache(maxsize=4)
+def _model_radiance(type_json: str, single_nodes, diffuse_nodes, smooth: bool):
+    """The paper's model at the measure's geometries (``measure.points``):
+    (θl, θv, φ) and each colour-free component's radiance f·cos θl
+    (N, T, C), computed once per paint type."""
+    from ..paint.core import Paint
+
+    paint = Paint.from_dict(json.loads(type_json))
+    opts = {}
+    if single_nodes is not None:
+        opts = {"single_nodes": single_nodes, "diffuse_nodes": diffuse_nodes}
+    tl, tv, ph = measure.points(smooth)
+    return (tl, tv, ph), paint.components(tl, tv, ph, **opts) * np.cos(tl)[:, None, None]
 
 
-def dense_points():
-    """``grid_points`` of ``DENSE_GRID`` without ``MIRROR_EXCLUSION``."""
-    return grid_points(DENSE_GRID, MIRROR_EXCLUSION)
+def model_radiance(lut):
+    """``_model_radiance`` of a loaded LUT's paint type, with the LUT's own
+    quadrature sizes."""
+    meta = lut.meta
+    single = tuple(meta["single_nodes"]) if "single_nodes" in meta else None
+    diffuse = tuple(meta["diffuse_nodes"]) if "diffuse_nodes" in meta else None
+    smooth = float(meta["type"]["slope"]) == 0.0
+    return _model_radiance(json.dumps(meta["type"], sort_keys=True), single, diffuse, smooth)
 
 
-def _acceptance_grams(lut, basis, cos_view, weights, evaluate, grid=ACCEPTANCE_GRID, points=None):
-    """(residual, reference) Gram matrices (T, C, C) on ``grid`` (default
-    ``ACCEPTANCE_GRID``) or at ``points`` (θl, θv, φ)."""
-    tl, tv, ph = grid_points(grid) if points is None else points
-    cos_l = np.cos(tl)
-    target = lut.components(tl, tv, ph) * cos_l[:, None, None]  # (N, T, C)
+def measure_grams(model, basis, cos_view, weights, evaluate):
+    """The fidelity measure's Gram matrices of a fit: (residual, reference)
+    over the whole grid and over the grazing band, each (T, C, C), from the
+    model's radiance ``model`` (``model_radiance``: points and (N, T, C)) and
+    the closures ``basis`` with the weights the node group reads."""
+    (tl, tv, ph), target = model
     values = np.array([evaluate(c, tl, tv, ph) for c in basis]).reshape(len(basis), tl.size)  # (K, N); K may be 0
-    fitted = np.einsum("kn,kcnt->ntc", values, resample_views(weights, cos_view, np.cos(tv)))
-    r = (fitted - target) * cos_l[:, None, None]
-    ref = target * cos_l[:, None, None]
-    return np.einsum("ntc,ntd->tcd", r, r), np.einsum("ntc,ntd->tcd", ref, ref)
+    fitted = np.einsum("kn,kcnt->ntc", values, texture_weights(weights, cos_view, np.cos(tv)))
+    r = fitted - target
+    band = measure.grazing(tl)
+
+    def grams(sel):
+        return np.einsum("ntc,ntd->tcd", r[sel], r[sel]), np.einsum("ntc,ntd->tcd", target[sel], target[sel])
+
+    return grams(slice(None)), grams(band)
 
 
 def _cycles(closure, theta_l, theta_v, phi):
@@ -512,10 +538,9 @@ def fit_lut(
     b = comps.reshape(m_, r_, t_ * c_)
     rhs = np.einsum("mrk,mrp->mpk", a, b)
     norm = np.einsum("mrp,mrp->mp", b, b)
-    # Views beyond the acceptance measure's range still get their weights but
-    # count less in the selection.
-    view_weight = np.where(theta_v <= SELECTION_VIEW, 1.0, 0.1)
-    norm = np.stack([norm, np.broadcast_to(view_weight[:, None], norm.shape)], axis=-1)
+    # Views count by their share of the measure; views beyond its range
+    # still get their weights but count less in the selection.
+    norm = np.stack([norm, np.broadcast_to(view_measure(theta_v)[:, None], norm.shape)], axis=-1)
     grey = np.array([c.grey for c in basis])
     facet = COMPONENTS.index("facet")
     allowed = np.array([[not grey[k] or p % c_ == facet for k in range(len(basis))] for p in range(t_ * c_)])
@@ -524,6 +549,7 @@ def fit_lut(
     mirror = float(type_dict["slope"]) == 0.0  # a smooth interface: its mirror is a closure of its own
     target_error = TARGET_ERROR[target]["smooth" if mirror else "rough"]
     goal = 0.25 * target_error
+    model = model_radiance(lut)
     caps = None
     if target == "EEVEE":
         from . import eevee
@@ -535,7 +561,7 @@ def fit_lut(
 
     def weights_of(chosen):
         """NNLS weights of the chosen closures, the kept closures and their
-        acceptance Gram matrices."""
+        measure's Gram matrices (whole, grazing band)."""
         weights = np.zeros((len(chosen), c_, m_, t_))
         for p in range(t_ * c_):
             idx = [i for i, k in enumerate(chosen) if allowed[p, k]]
@@ -549,7 +575,7 @@ def fit_lut(
             weights[g] = weights[g].mean(axis=-1, keepdims=True)
         keep = [i for i in range(len(chosen)) if weights[i].max() > 0]
         kept = [basis[chosen[i]] for i in keep]
-        return (kept, weights[keep], *_acceptance_grams(lut, kept, cos_view, weights[keep], evaluate))
+        return kept, weights[keep], *measure_grams(model, kept, cos_view, weights[keep], evaluate)
 
     def worst_component(grams):
         """The largest relative error of one component (the error of the
@@ -557,15 +583,14 @@ def fit_lut(
         return max((e for e in component_errors(*grams).values() if e is not None), default=0.0)
 
     chosen = _select(gram, rhs, norm, allowed, upper, cost, budget, goal**2, caps)
-    basis_kept, weights, residual, reference = weights_of(chosen)
-    if extra_budget > 0 and worst_component((residual, reference)) > target_error:
+    basis_kept, weights, whole, band = weights_of(chosen)
+    if extra_budget > 0 and worst_component(whole) > target_error:
         # Some colour of this type misses the target: select again with the
         # extra closures, and keep that choice if it lowers the worst
         # component's error.
         more = weights_of(_select(gram, rhs, norm, allowed, upper, cost, budget + extra_budget, goal**2, caps))
-        if worst_component(more[2:]) < worst_component((residual, reference)):
-            basis_kept, weights, residual, reference = more
-    dense_grams = _acceptance_grams(lut, basis_kept, cos_view, weights, evaluate, points=dense_points())
+        if worst_component(more[2]) < worst_component(whole):
+            basis_kept, weights, whole, band = more
     n = reference_index(type_dict["n"])
     dense = view_cosines(texture_views(views))
     return Fit(
@@ -575,15 +600,15 @@ def fit_lut(
         closures=basis_kept,
         cos_view=dense,
         weights=resample_views(weights, cos_view, dense),
-        residual=residual,
-        reference=reference,
+        residual=whole[0],
+        reference=whole[1],
         mirror=mirror,
         n=n,
         internal_reflectance=lut.internal_reflectance,
         lut_key=lut.key,
         calibration=tuple(calibration) if (calibration is not None and target == "EEVEE") else None,
-        dense_residual=dense_grams[0],
-        dense_reference=dense_grams[1],
+        grazing_residual=band[0],
+        grazing_reference=band[1],
     )
 
 
@@ -656,8 +681,8 @@ def read_fit(path) -> Fit:
             internal_reflectance=float(h["internal_reflectance"]),
             lut_key=h.get("lut_key", ""),
             calibration=tuple(h["calibration"]) if h.get("calibration") else None,
-            dense_residual=None if h.get("dense_residual") is None else np.array(h["dense_residual"], dtype=float),
-            dense_reference=None if h.get("dense_reference") is None else np.array(h["dense_reference"], dtype=float),
+            grazing_residual=np.array(h["grazing_residual"], dtype=float),
+            grazing_reference=np.array(h["grazing_reference"], dtype=float),
         )
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         if isinstance(exc, lutfile.LUTError):

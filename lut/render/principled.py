@@ -1,6 +1,6 @@
 """A Principled BSDF fallback for export: Cycles' Principled BSDF as a
 function of the light and view directions (numpy only), and the Principled
-parameters that best match a paint on the acceptance measure.
+parameters that best match a paint on the fidelity measure.
 
 glTF and USD exporters read only the Principled BSDF, so every paint
 material carries one (``addon.export``) whose parameters are fitted here.
@@ -31,9 +31,10 @@ by quadrature (the visible normals' density D_v = G1(v)·max(0, v·h)·D(h)/μ,
 Heitz, "Sampling the GGX distribution of visible normals", JCGT 7(4), 2018,
 Eq. 1) and read with the same interpolation.
 
-The fit (``fit_principled``) minimizes the acceptance error
-(``lut.render.fitting.ACCEPTANCE_GRID``: cos-weighted relative RMS of f·cos θl over
-θl, θv ≤ 75°, off the mirror): the base colour is linear in the radiance and
+The fit (``fit_principled``) minimizes the fidelity measure
+(``lut.render.measure``: relative RMS of the radiance f·cos θl) on a coarser
+grid of the measure's range, ``GRID``, off the mirror (a Principled BSDF
+draws no delta): the base colour is linear in the radiance and
 solved in closed form per channel (clipped to [0, 1]); roughness, IOR and
 the coat's parameters by Nelder-Mead from the best point of a coarse grid.
 """
@@ -46,8 +47,17 @@ import functools
 import numpy as np
 
 from ..models import _validate
+from . import measure
 from .closures import Closure, _ggx
-from .fitting import ACCEPTANCE_GRID
+
+#: The fit's grid: the fidelity measure's range (θl 0-75°, θv 5-75°, φ
+#: 0-180°) in 15°, 10° and 30° steps, less the geometries within
+#: ``measure.MIRROR_EXCLUSION`` of the mirror.
+GRID = (
+    np.radians(np.arange(0.0, 75.1, 15.0)),
+    np.radians(np.arange(5.0, 75.1, 10.0)),
+    np.radians(np.arange(0, 181, 30)),
+)
 
 #: Bounds of the fitted parameters (the Principled node's own ranges where it
 #: has them; IOR within what paints' binders and coats span, widened).
@@ -230,12 +240,11 @@ def radiance(params: PrincipledParams, theta_l, theta_v, phi) -> np.ndarray:
 
 
 def _grid():
-    tl, tv, ph = np.meshgrid(*ACCEPTANCE_GRID, indexing="ij")
-    return tl.ravel(), tv.ravel(), ph.ravel()
+    return measure.grid_points(GRID, measure.MIRROR_EXCLUSION)
 
 
 def reference(source, amplitudes=None) -> np.ndarray:
-    """f·cos θl of the paint on the acceptance grid, (N, 3): ``source`` a
+    """f·cos θl of the paint on the fit's grid ``GRID``, (N, 3): ``source`` a
     ``lut.Paint``, or a loaded LUT (``lut.lutfiles.baking.LUT``) with ``amplitudes``
     (3 channels × 3 components, ``Paint.amplitudes`` or
     ``lut.render.bake.amplitudes_of_inputs``)."""
@@ -258,11 +267,9 @@ def reference(source, amplitudes=None) -> np.ndarray:
 
 
 def error(params: PrincipledParams, ref: np.ndarray) -> float:
-    """The acceptance error of ``params`` against ``reference(...)``."""
+    """The fidelity measure of ``params`` against ``reference(...)`` on ``GRID``."""
     tl, tv, ph = _grid()
-    w = np.cos(tl)[:, None]
-    got = radiance(params, tl, tv, ph)
-    return float(np.sqrt(np.sum(((got - ref) * w) ** 2) / np.sum((ref * w) ** 2)))
+    return measure.relative_rms(radiance(params, tl, tv, ph), ref)
 
 
 def _solve_colour(spec, diffuse, ref, w2):
@@ -333,15 +340,15 @@ def _params_of(x, coat: bool):
 
 
 def fit_principled(source, amplitudes=None, *, coat: bool = True):
-    """The Principled parameters that best match a paint on the acceptance
+    """The Principled parameters that best match a paint on the fidelity
     measure: ``source`` a ``lut.Paint`` or a loaded LUT with ``amplitudes``
     (see ``reference``).  ``coat``: also try a coat layer (kept only where it
-    lowers the error).  Returns (PrincipledParams, acceptance error)."""
+    lowers the error).  Returns (PrincipledParams, its fidelity measure)."""
     ref = reference(source, amplitudes)
     if not np.all(np.isfinite(ref)) or np.sum(ref * ref) <= 0.0:
-        raise ValueError("the paint reflects nothing on the acceptance grid: nothing to fit")
+        raise ValueError("the paint reflects nothing on the fit grid: nothing to fit")
     tl, tv, ph = _grid()
-    w2 = np.cos(tl) ** 2
+    w2 = np.ones_like(tl)  # every geometry counted once (the measure)
     norm = float(np.sum(w2[:, None] * ref * ref))
 
     def objective(x, with_coat):
@@ -374,12 +381,12 @@ def fit_principled(source, amplitudes=None, *, coat: bool = True):
 def recolour(params: PrincipledParams, source, amplitudes=None):
     """The same fallback for another colour of the paint type: roughness,
     IOR and coat kept, the base colour solved again (exact per channel, one
-    evaluation of the Principled model on the acceptance grid), so a colour
+    evaluation of the Principled model on the fit grid), so a colour
     edit refreshes the export fallback at interactive cost.  Returns
-    (PrincipledParams, acceptance error)."""
+    (PrincipledParams, its fidelity measure)."""
     ref = reference(source, amplitudes)
     tl, tv, ph = _grid()
     spec, diffuse = _parts(params, tl, tv, ph)
-    colour, _ = _solve_colour(spec, diffuse, ref, np.cos(tl) ** 2)
+    colour, _ = _solve_colour(spec, diffuse, ref, np.ones_like(tl))
     params = dataclasses.replace(params, base_color=tuple(float(c) for c in colour))
     return params, error(params, ref)
