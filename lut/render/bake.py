@@ -42,10 +42,19 @@ class RenderBake:
 
     def errors(self, paint: Paint) -> dict:
         """{target: the error each fit reports for this paint (``Fit.error``:
-        cos-weighted relative RMS on the acceptance and dense grids, the
-        larger)}."""
+        the fidelity measure, ``lut.render.measure``, over its whole grid)}."""
+        return {target: whole for target, (whole, _) in self.all_errors(paint).items()}
+
+    def grazing_errors(self, paint: Paint) -> dict:
+        """{target: the fidelity measure each fit reports for this paint over
+        the grazing band, θl >= 60° (``Fit.grazing_error``)}."""
+        return {target: band for target, (_, band) in self.all_errors(paint).items()}
+
+    def all_errors(self, paint: Paint) -> dict:
+        """{target: (whole, grazing band)}: the fidelity measure each fit
+        reports for this paint (``lut.render.fitting.reported_errors``)."""
         amps = self.lut.amplitudes(paint)
-        return {target: fit.error(amps) for target, fit in self.fits.items()}
+        return {target: fitting.reported_errors(fit.grams(), amps) for target, fit in self.fits.items()}
 
 
 def _cached_fit(path, lut, target, exact_metallic, calibration):
