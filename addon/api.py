@@ -11,11 +11,12 @@ from __future__ import annotations
 import dataclasses
 import json
 import pathlib
+import typing
 
 import bpy
 
 from . import export, nodes, properties, validation
-from ._lut import closures, eevee, lut, render_bake
+from ._lut import closures, eevee, fitting, lut, measure, render_bake
 from .live import _loaded_lut, paint_of, update_inputs, working_space  # noqa: F401  (the API's names)
 
 #: LUTs go here, relative to the saved .blend file.
@@ -41,13 +42,31 @@ def lut_directory() -> pathlib.Path:
         return folder
 
 
+class FitError(typing.NamedTuple):
+    """An engine's fit error at a material's colours: the fidelity measure
+    (``lut.render.measure``) over its whole grid and over the grazing band
+    (θl >= 60°), each with its goal."""
+
+    error: float
+    target: float
+    grazing: float
+    grazing_target: float
+
+    @property
+    def missed(self) -> bool:
+        """Whether the whole measure or the grazing band misses its goal."""
+        return self.error > self.target or self.grazing > self.grazing_target
+
+
 @dataclasses.dataclass(frozen=True)
 class BakeStatus:
     """A material's bake status: ``state`` ("baked", "cached", "unused" or
     "failed"), ``reason`` (why it failed), ``errors`` ({engine: fit error at
-    the material's colours}), ``misses`` ({engine: (error, target)} where the
-    fit misses its target) and ``key`` (the paint type's LUT key: materials
-    with the same key shared one bake).  ``str()`` gives the line to show
+    the material's colours, the fidelity measure's whole grid}), ``misses``
+    ({engine: FitError} where the fit misses its goal, whole or grazing
+    band), ``key`` (the paint type's LUT key: materials with the same key
+    shared one bake) and ``grazing`` ({engine: the fit error over the
+    grazing band, θl >= 60°}).  ``str()`` gives the line to show
     ("failed: <reason>"); read the fields, never that text.  For scripts of
     earlier releases, which got the text itself, a status compares equal to
     its state's name (``status == "baked"``, ``status in {"baked",
@@ -58,6 +77,7 @@ class BakeStatus:
     errors: dict = dataclasses.field(default_factory=dict)
     misses: dict = dataclasses.field(default_factory=dict)
     key: str = ""
+    grazing: dict = dataclasses.field(default_factory=dict)
 
     def __str__(self):
         return f"{self.state}: {self.reason}" if self.reason else self.state
@@ -102,7 +122,9 @@ def store_result(material, paint: lut.Paint, result: render_bake.RenderBake, exa
     settings.internal_reflectance = result.lut.internal_reflectance
     settings.diffuse_albedo = render_bake.diffuse_albedo(result.lut)
     nodes.build_seen_group(result.fits[next(iter(result.fits))], settings.diffuse_albedo)
-    settings.fits = json.dumps({target: {**f.grams(), "goal": f.target_error} for target, f in result.fits.items()})
+    settings.fits = json.dumps(
+        {target: {**f.grams(), "goal": f.target_error, "goals": list(f.goals)} for target, f in result.fits.items()}
+    )
     export.update_fallback(material, paint)
     if clear_stale:
         settings.stale = False
@@ -140,10 +162,12 @@ def finish_background_bake(material, paint, result, type_key_at_start) -> bool:
 
 
 def fit_errors(material) -> dict:
-    """{engine: (error, target)} of the material's current colours against
-    its bake's fits (``lut.render.fitting.reported_error``: cos-weighted relative
-    RMS on the acceptance grid and a dense grid, the larger); empty before a
-    bake."""
+    """{engine: FitError} of the material's current colours against its
+    bake's fits: the fidelity measure (``lut.render.measure``) over its whole
+    grid and over the grazing band, with their goals
+    (``lut.render.fitting.reported_errors``); empty before a bake.  A bake
+    stored without the grazing band's matrices (an earlier release) reports
+    the whole figure for the band too."""
     settings = material.paint_lut
     if not settings.fits or settings.internal_reflectance <= 0:
         return {}
@@ -155,7 +179,21 @@ def fit_errors(material) -> dict:
     amps = render_bake.amplitudes_of_inputs(
         render_bake.node_inputs(paint, settings.internal_reflectance), settings.internal_reflectance
     )
-    return {target: (lut.render.fitting.reported_error(f, amps), float(f["goal"])) for target, f in fits.items()}
+    out = {}
+    for target, f in fits.items():
+        whole, grazing = fitting.reported_errors(f, amps)
+        kind = measure.goals(target, paint.slope == 0)  # an earlier release stored the whole goal alone
+        goals = f.get("goals") or (f.get("goal", kind[0]), kind[1])
+        out[target] = FitError(whole, float(goals[0]), grazing, float(goals[1]))
+    return out
+
+
+def _result_errors(result: render_bake.RenderBake, paint) -> dict:
+    """{engine: FitError} of a bake's fits at a paint's colours."""
+    return {
+        target: FitError(whole, result.fits[target].goals[0], grazing, result.fits[target].goals[1])
+        for target, (whole, grazing) in result.all_errors(paint).items()
+    }
 
 
 def set_paint(material, paint: lut.Paint) -> None:
@@ -337,7 +375,7 @@ def bake_materials(used, force=False, *, directory=None, exact_metallic=None, **
                 status[material.name] = _status("cached", errors, key)
                 continue
             result = bake_material(material, directory=directory, force=force, exact_metallic=exact_metallic, **options)
-            errors = {t: (e, result.fits[t].target_error) for t, e in result.errors(paint).items()}
+            errors = _result_errors(result, paint)
             status[material.name] = _status("baked", errors, result.lut_path.stem.split("-")[-1])
         except (ValueError, OSError, RuntimeError, TypeError, KeyError) as exc:
             status[material.name] = BakeStatus("failed", str(exc) or type(exc).__name__)
@@ -345,8 +383,14 @@ def bake_materials(used, force=False, *, directory=None, exact_metallic=None, **
 
 
 def _status(state, errors, key):
-    misses = {t: v for t, v in errors.items() if v[0] > v[1]}
-    return BakeStatus(state, errors={t: v[0] for t, v in errors.items()}, misses=misses, key=key)
+    """A status from {engine: FitError}: a miss where either figure misses its goal."""
+    return BakeStatus(
+        state,
+        errors={t: v.error for t, v in errors.items()},
+        misses={t: v for t, v in errors.items() if v.missed},
+        key=key,
+        grazing={t: v.grazing for t, v in errors.items()},
+    )
 
 
 def bake_scene(scene, force=False, **options) -> dict:

@@ -134,11 +134,25 @@ def bake_one(material, used, force=False, **options) -> dict:
 
 def _fit_entry(material) -> dict:
     """The paint type's LUT key (materials with one key shared one bake) and
-    each engine's fit error at the material's colours, with its target."""
+    each engine's fit error at the material's colours (the fidelity measure,
+    whole and over the grazing band), with their targets."""
     entry = {"type": pathlib.Path(material.paint_lut.lut_path).stem.removeprefix("paintlut-")}
     errors = api.fit_errors(material)
-    entry["fit"] = {t: {"error": round(e, 5), "target": g} for t, (e, g) in errors.items()}
-    misses = [f"{t.title()} {100 * e:.1f}% > {100 * g:.0f}%" for t, (e, g) in errors.items() if e > g]
+    entry["fit"] = {
+        t: {
+            "error": round(f.error, 5),
+            "target": f.target,
+            "grazing": round(f.grazing, 5),
+            "grazing_target": f.grazing_target,
+        }
+        for t, f in errors.items()
+    }
+    misses = []
+    for t, f in errors.items():
+        if f.error > f.target:
+            misses.append(f"{t.title()} {100 * f.error:.1f}% > {100 * f.target:.0f}%")
+        if f.grazing > f.grazing_target:
+            misses.append(f"{t.title()} grazing light {100 * f.grazing:.1f}% > {100 * f.grazing_target:.0f}%")
     if misses:
         entry["fit_misses"] = misses
     return entry

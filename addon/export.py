@@ -39,7 +39,7 @@ def add_principled_fallback(material, params: principled.PrincipledParams, error
     """Give ``material`` a Principled BSDF with ``params`` into an active
     Material Output for all engines (created, or updated in place when the
     material has them), leaving the engine-specific outputs active.  Records
-    the parameters (and ``error``, the fit's acceptance error) in the
+    the parameters (and ``error``, the fit's fidelity measure) in the
     material's ``paint_lut_principled`` property.  Returns the BSDF node."""
     if not isinstance(params, principled.PrincipledParams):
         raise TypeError(f"params must be a lut.render.principled.PrincipledParams, got {type(params).__name__}")
@@ -83,7 +83,7 @@ def fallback_params(material):
 def update_fallback(material, paint):
     """Fit the Principled fallback to a material's paint (``paint``: a
     lut.Paint, ``api.paint_of(material)`` for its own settings) and add it:
-    call after each bake.  Returns (PrincipledParams, acceptance error)."""
+    call after each bake.  Returns (PrincipledParams, its fidelity measure)."""
     try:
         params, error = principled.fit_principled(paint)
     except ValueError:

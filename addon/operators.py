@@ -58,11 +58,14 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
         return {"FINISHED"}
 
     def _report_fit(self, material):
-        for target, (error, goal) in api.fit_errors(material).items():
-            if error > goal:
-                self.report(
-                    {"WARNING"}, f"Paint LUT: {target.title()} fit {100 * error:.1f}% misses its {100 * goal:.0f}%"
-                )
+        for target, fit in api.fit_errors(material).items():
+            missed = []
+            if fit.error > fit.target:
+                missed.append(f"{100 * fit.error:.1f}% misses its {100 * fit.target:.0f}%")
+            if fit.grazing > fit.grazing_target:
+                missed.append(f"grazing light {100 * fit.grazing:.1f}% misses its {100 * fit.grazing_target:.0f}%")
+            if missed:
+                self.report({"WARNING"}, f"Paint LUT: {target.title()} fit {', '.join(missed)}")
 
     def modal(self, context, event):
         if event.type == "ESC":

@@ -30,9 +30,17 @@ def draw_settings(layout, material):
         layout.label(text="Paint type changed since the last bake", icon="ERROR")
     elif settings.lut_path:
         layout.label(text=bpy.path.basename(settings.lut_path), icon="CHECKMARK")
-        for target, (error, goal) in api.fit_errors(material).items():
-            icon = "CHECKMARK" if error <= goal else "ERROR"
-            layout.label(text=f"{target.title()} fit error {100 * error:.1f}% (target {100 * goal:.0f}%)", icon=icon)
+        for target, fit in api.fit_errors(material).items():
+            layout.label(text=fit_error_text(target, fit), icon="ERROR" if fit.missed else "CHECKMARK")
+
+
+def fit_error_text(target, fit) -> str:
+    """The panel's line for an engine's ``api.FitError``: the fidelity
+    measure over its whole grid and over the grazing band, with their goals."""
+    return (
+        f"{target.title()} fit error {100 * fit.error:.1f}% (target {100 * fit.target:.0f}%), "
+        f"grazing light {100 * fit.grazing:.1f}% (target {100 * fit.grazing_target:.0f}%)"
+    )
 
 
 class _PaintLUTPanel:

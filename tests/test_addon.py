@@ -13,7 +13,7 @@ bpy = pytest.importorskip("bpy")
 
 import lut  # noqa: E402
 from lut.render import bake as render_bake  # noqa: E402
-from lut.render import fitting  # noqa: E402
+from lut.render import fitting, measure  # noqa: E402
 
 SMALL = {"resolution": (8, 6, 4)}
 
@@ -167,11 +167,68 @@ def test_bake_records_the_lut_the_fits_and_their_errors(material, lut_dir):
     errors = api.fit_errors(material)
     assert set(errors) == {"CYCLES", "EEVEE"}
     paint = api.paint_of(material)
-    for target, (error, goal) in errors.items():
-        assert error == pytest.approx(result.fits[target].error(result.lut.amplitudes(paint)), rel=1e-6)
-        assert goal == fitting.TARGET_ERROR[target]["smooth"]
+    for target, fit in errors.items():
+        amps = result.lut.amplitudes(paint)
+        assert isinstance(fit, api.FitError)
+        assert fit.error == pytest.approx(result.fits[target].error(amps), rel=1e-6)
+        assert fit.grazing == pytest.approx(result.fits[target].grazing_error(amps), rel=1e-6)
+        assert (fit.target, fit.grazing_target) == measure.goals(target, smooth=True)
+        assert fit.target == fitting.TARGET_ERROR[target]["smooth"]
+        assert fit.missed == (fit.error > fit.target or fit.grazing > fit.grazing_target)
+    assert all(result.errors(paint)[t] == pytest.approx(f.error, rel=1e-6) for t, f in errors.items())
+    assert all(result.grazing_errors(paint)[t] == pytest.approx(f.grazing, rel=1e-6) for t, f in errors.items())
     material.paint_lut.single = (0.3, 0.3, 0.3)  # the error follows the colours' mix at once
-    assert api.fit_errors(material)["CYCLES"][0] != pytest.approx(errors["CYCLES"][0], rel=1e-3)
+    edited = api.fit_errors(material)
+    amps = result.lut.amplitudes(api.paint_of(material))
+    for target, fit in edited.items():
+        assert fit.error == pytest.approx(result.fits[target].error(amps), rel=1e-6)
+        assert fit.grazing == pytest.approx(result.fits[target].grazing_error(amps), rel=1e-6)
+    # (Cycles' single-scatter and diffuse components miss by nearly the same
+    # on this coarse LUT: its whole figure hardly moves, its grazing one does.)
+    assert edited["CYCLES"].grazing != pytest.approx(errors["CYCLES"].grazing, rel=1e-3)
+    assert edited["EEVEE"].error != pytest.approx(errors["EEVEE"].error, rel=1e-3)
+
+
+def test_fit_errors_of_a_bake_stored_by_an_earlier_release(material, lut_dir):
+    """A material baked by an earlier release stored its fits' matrices
+    without the grazing band's and one goal: its errors still show, the
+    grazing figure the whole one, the grazing goal the measure's."""
+    from addon import api
+
+    api.bake_material(material, directory=lut_dir, **SMALL)
+    current = api.fit_errors(material)
+    stored = json.loads(material.paint_lut.fits)
+    for fit in stored.values():
+        for key in ("grazing_residual", "grazing_reference", "goals"):
+            del fit[key]
+    material.paint_lut.fits = json.dumps(stored)
+    errors = api.fit_errors(material)
+    assert set(errors) == {"CYCLES", "EEVEE"}
+    for target, fit in errors.items():
+        assert fit.error == pytest.approx(current[target].error, rel=1e-12)
+        assert fit.grazing == fit.error
+        assert (fit.target, fit.grazing_target) == measure.goals(target, smooth=True)
+
+
+def test_the_panel_and_the_status_show_both_figures(material, lut_dir):
+    """The panel's line names the whole measure and the grazing band, each
+    with its goal; a miss of either is a miss (the panel's warning icon,
+    ``BakeStatus.misses``)."""
+    from addon import api, panels
+
+    fit = api.FitError(0.012, 0.02, 0.034, 0.04)
+    assert panels.fit_error_text("CYCLES", fit) == "Cycles fit error 1.2% (target 2%), grazing light 3.4% (target 4%)"
+    assert not fit.missed
+    assert api.FitError(0.012, 0.02, 0.05, 0.04).missed and api.FitError(0.03, 0.02, 0.01, 0.04).missed
+    status = api._status("baked", {"CYCLES": fit, "EEVEE": api.FitError(0.02, 0.03, 0.07, 0.06)}, "key")
+    assert status.errors == {"CYCLES": 0.012, "EEVEE": 0.02}
+    assert status.grazing == {"CYCLES": 0.034, "EEVEE": 0.07}
+    assert status.misses == {"EEVEE": api.FitError(0.02, 0.03, 0.07, 0.06)}
+    api.bake_material(material, directory=lut_dir, **SMALL)
+    layout = _Layout()
+    panels.draw_settings(layout, material)
+    lines = [text for text, _ in layout.labels if "fit error" in text]
+    assert len(lines) == 2 and all("grazing light" in text for text in lines)
 
 
 def test_glossy_black_bakes_and_renders_only_its_mirror(material, lut_dir):
@@ -528,6 +585,7 @@ class _Layout:
 
     def __init__(self):
         self.props = []
+        self.labels = []
 
     def prop(self, data, name):
         assert name in data.bl_rna.properties, name
@@ -538,8 +596,8 @@ class _Layout:
 
     row = column
 
-    def label(self, **_):
-        pass
+    def label(self, text="", icon="NONE", **_):
+        self.labels.append((text, icon))
 
     def operator(self, *_, **__):
         pass
