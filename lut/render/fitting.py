@@ -110,7 +110,7 @@ SELECTION_VIEW = np.radians(80.0)
 
 _CANDIDATES_CHECKED = 4
 
-#: The rows a fit is made on, each tried in turn (the fit kept is the one
+#: The rows a fit is made on, tried in turn until one meets its goals (the fit kept is the one
 #: nearest its goals on the measure, ``shortfall``): "hemisphere", light
 #: directions of a half-vector grid weighted by their share of the measure
 #: (a continuous integral, dense about the mirror); "lattice", those and the
@@ -559,8 +559,8 @@ def fit_lut(
     (defaults ``BUDGET``, ``EXTRA_BUDGET``).  ``calibration``: for EEVEE, the
     Blender line whose measured closure responses to fit with (``lut.render.eevee``;
     None: Cycles' formulas, EEVEE's own rendering unmodelled).  ``row_sets``:
-    the rows to fit on, each tried (``ROW_SETS``); the fit kept is the one
-    whose worst component is lowest on the measure."""
+    the rows to fit on, tried in turn (``ROW_SETS``) until a fit meets its
+    goals; the fit kept is the one nearest them (``shortfall``)."""
     target = closures.validate_target(target)
     evaluate = evaluator_for(target, calibration)
     budget = BUDGET[target] if budget is None else int(budget)
@@ -587,6 +587,8 @@ def fit_lut(
         fitted = _fit_rows(lut, target, evaluate, basis, theta_v, theta_l, phi, row_w, model, budget, extra_budget)
         if best is None or fitted[-1] < best[-1]:
             best = fitted
+        if best[-1] <= 1.0:  # every colour of the type meets both goals: the next sets need not be tried
+            break
     basis_kept, weights, whole, band, _ = best
     n = reference_index(type_dict["n"])
     dense = view_cosines(texture_views(views))
