@@ -11,9 +11,9 @@ import pytest
 pytest.importorskip("bpy")
 
 import lut  # noqa: E402
-from addon.scenes import Oracle, paint_material, paints, relative_rms  # noqa: E402
+from addon.scenes import Oracle, oracle_errors, paint_material, paints  # noqa: E402
 from lut import bench, models  # noqa: E402
-from lut.render import closures, fitting  # noqa: E402
+from lut.render import closures, fitting, measure  # noqa: E402
 
 pytestmark = pytest.mark.render
 
@@ -116,38 +116,43 @@ def test_every_closure_kind_renders_as_its_formula_through_the_node_group(regist
         np.testing.assert_allclose(got, want, rtol=2e-3 if closure.kind == "ggx" else 2e-4, atol=2e-6)
 
 
-#: The targets: 2% for smooth paints, 5% for rough ones.
-TARGETS = {"smooth": 0.02, "rough": 0.05}
-
-
 @pytest.mark.parametrize("name", list(paints()))
 def test_named_paints_render_within_target(registered_oracle, name, tmp_path):
-    """The acceptance measure on the paper's presets and the smooth, satin
-    and matte paints: rendered radiance against Paint.brdf · cos θl for θl,
-    θv <= 75° away from the mirror direction, cos-weighted relative RMS
-    <= 2% (smooth) or 5% (rough), through the add-on's own bake."""
+    """The fidelity measure (``lut.render.measure``) on the paper's presets
+    and the smooth, satin and matte paints, through the add-on's own bake:
+    rendered radiance against Paint.brdf · cos θl at every geometry of the
+    measure's grid (a smooth paint's mirror left out), whole and over
+    the grazing band, each within its Cycles goal (``measure.goals``: 2% and
+    4% smooth, 5% and 10% rough)."""
     paint = paints()[name]
     paint_material(registered_oracle, paint, tmp_path)
-    assert relative_rms(registered_oracle, paint) < TARGETS["rough" if paint.slope > 0 else "smooth"]
+    whole, grazing = oracle_errors(registered_oracle, paint)
+    goals = measure.goals("CYCLES", paint.slope == 0)
+    assert whole < goals[0], (whole, grazing, goals)
+    assert grazing < goals[1], (whole, grazing, goals)
 
 
 def test_randomised_paints_render_as_their_fits_promise(registered_oracle, tmp_path):
     """Twenty paints drawn over the panel's ranges (lut.bench.random_paints,
-    fixed seed): each rendered by Cycles within half a percent of the error
-    its fit reports (so the panel's figure is the truth), the median well
-    within target, and every paint within target except those whose fit
-    reports the miss (the README lists them)."""
+    fixed seed), on the fidelity measure, whole and over the grazing band:
+    each rendered by Cycles no more than half a percent above the errors its
+    fit reports and within half a percent plus a tenth of them either way
+    (so the panel's figures are the truth); on the whole measure the median
+    well within the goal, and every paint within its goal except those whose
+    fit reports the miss (the README lists them)."""
     rows = []
     for label, paint in bench.random_paints(20):
         _, result = paint_material(registered_oracle, paint, tmp_path)
-        predicted = result.errors(paint)["CYCLES"]
-        rendered = relative_rms(registered_oracle, paint)
-        rows.append((label, paint.slope > 0, rendered, predicted))
-        assert abs(rendered - predicted) < 0.005 + 0.1 * predicted, (label, rendered, predicted)
+        reported = result.all_errors(paint)["CYCLES"]
+        rendered_both = oracle_errors(registered_oracle, paint)
+        for rendered, predicted in zip(rendered_both, reported, strict=True):
+            assert rendered <= predicted + 0.005, (label, rendered_both, reported)
+            assert abs(rendered - predicted) < 0.005 + 0.1 * predicted, (label, rendered_both, reported)
+        rows.append((label, paint.slope > 0, rendered_both[0], reported[0]))
     for rough in (False, True):
         values = [r for _, kind, r, _ in rows if kind == rough]
-        assert np.median(values) < 0.6 * TARGETS["rough" if rough else "smooth"], values
-    misses = [(label, r, p, TARGETS["rough" if rough else "smooth"]) for label, rough, r, p in rows]
+        assert np.median(values) < 0.6 * measure.goals("CYCLES", not rough)[0], values
+    misses = [(label, r, p, measure.goals("CYCLES", not rough)[0]) for label, rough, r, p in rows]
     misses = [m for m in misses if m[1] > m[3]]
     assert all(p > 0.9 * target for _, _, p, target in misses), misses  # every miss is reported by its fit
     assert len(misses) <= 1, misses
@@ -156,7 +161,7 @@ def test_randomised_paints_render_as_their_fits_promise(registered_oracle, tmp_p
 def test_a_textured_pigment_renders_every_patch_as_its_paint(registered_oracle, tmp_path):
     """An Image Texture of four colours (2x2, Closest) drives Pigment Color:
     every pixel renders the paint of its patch's colour, within the rough
-    target, over a grid of geometries."""
+    goal of the fidelity measure, over a subgrid of its geometries."""
     import bpy
 
     oracle = registered_oracle
@@ -181,7 +186,7 @@ def test_a_textured_pigment_renders_every_patch_as_its_paint(registered_oracle, 
     probe = tree.nodes.new("ShaderNodeEmission")
     tree.links.new(texture.outputs["Color"], probe.inputs["Color"])
     output = tree.get_output_node("CYCLES")
-    grid = (np.radians([0, 30, 60, 75]), np.radians([5, 35, 65]), (0.4, 1.9, 3.1))
+    grid = (np.radians([0, 30, 60, 75]), np.radians([5, 35, 65]), np.radians([0, 90, 180]))
     num, den = np.zeros(4), np.zeros(4)
     for tl in grid[0]:
         for tv in grid[1]:
@@ -194,11 +199,11 @@ def test_a_textured_pigment_renders_every_patch_as_its_paint(registered_oracle, 
                     mask = np.all(np.abs(seen - colour) < 1e-4, axis=-1)
                     paint = lut.Paint(**{**base.__dict__, "rho": colour})
                     model = paint.brdf(tl, tv, phi) * np.cos(tl)
-                    num[i] += np.sum(((shaded[mask] - model) * np.cos(tl)) ** 2)
-                    den[i] += np.sum((model * np.cos(tl)) ** 2) * mask.sum()
+                    num[i] += np.sum((shaded[mask] - model) ** 2)
+                    den[i] += np.sum(model**2) * mask.sum()
     assert np.all(den > 0), "every patch is seen"
     errors = np.sqrt(num / den)
-    assert errors.max() < TARGETS["rough"], errors
+    assert errors.max() < measure.goals("CYCLES", smooth=False)[0], errors
 
 
 @pytest.mark.parametrize(("n", "roughness"), [(1.5, 0.5), (1.33, 0.3), (1.6, 0.8)])

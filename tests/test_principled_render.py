@@ -13,9 +13,9 @@ import pytest
 bpy = pytest.importorskip("bpy")
 
 import lut  # noqa: E402
-from addon.scenes import EEVEE, Oracle, principled_params_material, relative_rms  # noqa: E402
+from addon.scenes import EEVEE, Oracle, oracle_errors, principled_params_material  # noqa: E402
 from addon.scenes import principled as artists_principled  # noqa: E402
-from lut.render import principled  # noqa: E402
+from lut.render import measure, principled  # noqa: E402
 
 pytestmark = pytest.mark.render
 
@@ -60,12 +60,14 @@ def test_fitted_fallback_renders_with_its_error_and_beats_the_artist(oracle, nam
     material = oracle.material("paint")
     api.set_paint(material, paint)
     params, error = export.update_fallback(material, api.paint_of(material))
-    # Not baked yet: the fallback is what renders (no engine outputs).
-    rendered = relative_rms(oracle, paint)
+    # Not baked yet: the fallback is what renders (no engine outputs),
+    # measured at the geometries its fit is measured on.
+    points = measure.grid_points(principled.GRID, measure.MIRROR_EXCLUSION)
+    rendered = oracle_errors(oracle, paint, points=points)[0]
     assert rendered == pytest.approx(error, rel=0.02, abs=5e-4)
     artist_material = artists_principled(oracle, paint)
     assert artist_material.node_tree.nodes["Principled BSDF"].distribution == "MULTI_GGX"
-    artist = relative_rms(oracle, paint)
+    artist = oracle_errors(oracle, paint, points=points)[0]
     print(f"{name}: fallback {rendered:.4f} (fit {error:.4f}), artist {artist:.4f}")
     assert rendered < 0.8 * artist
 
