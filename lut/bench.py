@@ -324,3 +324,19 @@ def binned_error(theta_l, theta_v, phi, rendered, model, min_pixels=3, smooth=Tr
         num += np.sum((got - want) ** 2)
         den += np.sum(want**2)
     return float(np.sqrt(num / den)), int(used.sum())
+
+
+def binned_errors(theta_l, theta_v, phi, rendered, model, min_pixels=3, smooth=True):
+    """``binned_error`` whole and over the measure's grazing band (the bins
+    of θl >= ``measure.GRAZING``): (whole, grazing or None where no bin of
+    the band holds enough samples, bins used)."""
+    theta_l = np.asarray(theta_l, dtype=float).ravel()
+    whole, bins = binned_error(theta_l, theta_v, phi, rendered, model, min_pixels, smooth)
+    step = measure.GRID[0][1] - measure.GRID[0][0]
+    band = theta_l >= measure.GRAZING - step / 2  # the samples of the band's bins
+    pick = [np.asarray(a, dtype=float).reshape(theta_l.size, -1)[band] for a in (theta_v, phi, rendered, model)]
+    try:
+        grazing = binned_error(theta_l[band], pick[0][:, 0], pick[1][:, 0], pick[2], pick[3], min_pixels, smooth)[0]
+    except ValueError:
+        grazing = None
+    return whole, grazing, bins

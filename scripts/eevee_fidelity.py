@@ -1,5 +1,5 @@
-"""EEVEE render fidelity of paint materials on the randomised acceptance set,
-for the running Blender line (the README's EEVEE column).
+"""EEVEE render fidelity of paint materials on the randomised set, for the
+running Blender line (the README's EEVEE column).
 
     .venv/bin/python scripts/eevee_fidelity.py [--random 24] [--seed 2026] [--out FILE.json]
     .venv/bin/python scripts/eevee_fidelity.py --named   # the presets and named paints
@@ -13,12 +13,13 @@ Sun without shadows, black world, one sample per pixel, film filter off).
 One render fixes the angle γ between light and view; a sweep of γ gives
 every sphere's pixels a spread of (θl, θv, φ) (from the Normal pass), so one
 sweep measures every paint at once.  Each paint's pixels are compared with
-``Paint.brdf``·cos θl by ``lut.bench.binned_error``: the acceptance measure
-(cos-weighted relative RMS, θl, θv <= 75°, away from the mirror direction)
-on 5° × 5° × 15° bins.  Printed beside it: the error the EEVEE fit reports
-(``Fit.error``, on the acceptance and dense grids: what the panel shows).  And, for the viewport
-against the final render, the same pixels against Cycles' render of the
-same materials (``--cycles``)."""
+``Paint.brdf``·cos θl by ``lut.bench.binned_errors``: the fidelity measure
+(``lut.render.measure``: relative RMS of radiance, every bin of its 5° × 5°
+× 10° grid counted once, a smooth paint's mirror left out), whole and over
+the grazing band (θl >= 60°).  Printed beside it: the errors the EEVEE fit
+reports (``Fit.error``, ``Fit.grazing_error``: what the panel shows).  And,
+for the viewport against the final render, the same pixels against Cycles'
+render of the same materials (``--cycles``)."""
 
 from __future__ import annotations
 
@@ -38,7 +39,7 @@ if str(ROOT) not in sys.path:
 
 from lut import bench  # noqa: E402
 from lut.lutfiles import files  # noqa: E402
-from lut.render import fitting  # noqa: E402
+from lut.render import measure as fidelity  # noqa: E402
 
 #: Light-view angles of the sweep (degrees).
 GAMMAS = tuple(range(0, 176, 10))
@@ -50,10 +51,11 @@ CELL = 48
 def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None):
     """Per (label, lut.Paint) of ``paints`` (materials baked in
     ``directory``): {"label", "paint", "eevee" (rendered error), "eevee_fit"
-    and "cycles_fit" (the errors the fits report), "bins"}, and with ``cycles`` "cycles" (the
-    same spheres in Cycles against the model) and "eevee_vs_cycles" (EEVEE's
-    pixels against Cycles'); ``raw``: a dict to receive each paint's samples.
-    The add-on must be registered."""
+    and "cycles_fit" (the errors the fits report), "bins"}, and with
+    ``cycles`` "cycles" (the same spheres in Cycles against the model) and
+    "eevee_vs_cycles" (EEVEE's pixels against Cycles'); each error also as
+    "<key>_grazing", over the grazing band.  ``raw``: a dict to receive each
+    paint's samples.  The add-on must be registered."""
     from addon import api
     from scripts.calibrate_eevee import SphereScene
 
@@ -63,14 +65,12 @@ def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None)
         material = api.new_material(label, paint, directory=directory)
         sphere.data.materials.append(material)
         reported = api.fit_errors(material)
-        rows.append(
-            {
-                "label": label,
-                "paint": paint,
-                "eevee_fit": reported.get("EEVEE", (None,))[0],
-                "cycles_fit": reported.get("CYCLES", (None,))[0],
-            }
-        )
+        row = {"label": label, "paint": paint}
+        for engine in ("EEVEE", "CYCLES"):
+            fit = reported.get(engine)
+            row[f"{engine.lower()}_fit"] = None if fit is None else fit.error
+            row[f"{engine.lower()}_fit_grazing"] = None if fit is None else fit.grazing
+        rows.append(row)
     samples = _sweep(scene, gammas)
     cycles_samples = None
     if cycles:
@@ -84,14 +84,17 @@ def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None)
         scene.scene.render.engine = engine
     for i, row in enumerate(rows):
         tl, tv, ph, rgb = samples[i]
+        smooth = row["paint"].slope == 0
         model = row["paint"].brdf(tl, tv, ph) * np.cos(tl)[:, None]
-        row["eevee"], row["bins"] = bench.binned_error(tl, tv, ph, rgb, model)
+        row["eevee"], row["eevee_grazing"], row["bins"] = bench.binned_errors(tl, tv, ph, rgb, model, smooth=smooth)
         if raw is not None:
             raw[row["label"]] = (tl, tv, ph, rgb, model, None if cycles_samples is None else cycles_samples[i][3])
         if cycles_samples is not None:
             crgb = cycles_samples[i][3]
-            row["cycles"] = bench.binned_error(tl, tv, ph, crgb, model)[0]
-            row["eevee_vs_cycles"] = bench.binned_error(tl, tv, ph, rgb, crgb)[0]
+            row["cycles"], row["cycles_grazing"], _ = bench.binned_errors(tl, tv, ph, crgb, model, smooth=smooth)
+            row["eevee_vs_cycles"], row["eevee_vs_cycles_grazing"], _ = bench.binned_errors(
+                tl, tv, ph, rgb, crgb, smooth=smooth
+            )
     return rows
 
 
@@ -110,13 +113,21 @@ def _sweep(scene, gammas):
 
 
 def summary(rows, key="eevee"):
-    """{class: (worst, median, count)} of ``key`` over the rows, smooth and rough."""
+    """{class: (worst, median, count)} of ``key`` over the rows, smooth and
+    rough (rows without the figure left out)."""
     out = {}
     for name, rough in (("smooth", False), ("rough", True)):
         values = [r[key] for r in rows if (r["paint"].slope > 0) == rough and r.get(key) is not None]
         if values:
             out[name] = (max(values), float(np.median(values)), len(values))
     return out
+
+
+def _pair(row, key) -> str:
+    """A row's figure, whole / grazing band."""
+    whole, grazing = row.get(key), row.get(f"{key}_grazing")
+    shown = [" n/a  " if v is None else f"{v:6.2%}" for v in (whole, grazing)]
+    return " / ".join(shown)
 
 
 def main(argv=None) -> int:
@@ -149,26 +160,39 @@ def main(argv=None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         rows = measure(paints, args.luts or pathlib.Path(tmp), cycles=args.cycles)
     report = {"blender": version, "seed": args.seed, "paints": {}}
+    figures = ("eevee", "eevee_fit", "bins", "cycles", "cycles_fit", "eevee_vs_cycles")
     for row in rows:
         report["paints"][row["label"]] = {
             "rough": row["paint"].slope > 0,
-            **{k: row.get(k) for k in ("eevee", "eevee_fit", "bins", "cycles", "cycles_fit", "eevee_vs_cycles")},
+            **{k: row.get(k) for k in figures},
+            **{f"{k}_grazing": row.get(f"{k}_grazing") for k in figures if k != "bins"},
         }
-        shown = "" if row["eevee_fit"] is None else f"{row['eevee_fit']:6.2%}"
         extra = ""
         if "cycles" in row:
-            extra = f"  Cycles {row['cycles']:6.2%}  EEVEE vs Cycles {row['eevee_vs_cycles']:6.2%}"
-        print(f"{row['label']:28s} EEVEE {row['eevee']:6.2%}  fit reports {shown}  ({row['bins']} bins){extra}")
+            extra = f"  Cycles {_pair(row, 'cycles')}  EEVEE vs Cycles {_pair(row, 'eevee_vs_cycles')}"
+        print(
+            f"{row['label']:28s} EEVEE {_pair(row, 'eevee')}  fit reports {_pair(row, 'eevee_fit')}"
+            f"  ({row['bins']} bins){extra}"
+        )
+    print("(each figure: whole measure / grazing band, theta_l >= 60 degrees)")
     report["summary"] = {}
     for key in ("eevee", "cycles", "eevee_vs_cycles"):
-        targets = fitting.TARGET_ERROR["CYCLES" if key == "cycles" else "EEVEE"]
-        for name, (worst, median, count) in summary(rows, key).items():
-            report["summary"][f"{key} {name}"] = {"worst": worst, "median": median, "count": count}
-            met = sum(1 for r in rows if (r["paint"].slope > 0) == (name == "rough") and r[key] <= targets[name])
-            print(
-                f"{key:16s} {name:6s} n={count:2d} worst {worst:.2%} median {median:.2%};"
-                f" {met} within {targets[name]:.0%}"
-            )
+        engine = "CYCLES" if key == "cycles" else "EEVEE"
+        for band in ("", "_grazing"):
+            for name, (worst, median, count) in summary(rows, key + band).items():
+                report["summary"][f"{key}{band} {name}"] = {"worst": worst, "median": median, "count": count}
+                goal = fidelity.goals(engine, name == "smooth")[1 if band else 0]
+                met = sum(
+                    1
+                    for r in rows
+                    if (r["paint"].slope > 0) == (name == "rough")
+                    and r.get(key + band) is not None
+                    and r[key + band] <= goal
+                )
+                print(
+                    f"{key + band:24s} {name:6s} n={count:2d} worst {worst:.2%} median {median:.2%};"
+                    f" {met} within {goal:.0%}"
+                )
     files.atomic_write_text(args.out, json.dumps(report, indent=2) + "\n")
     print(f"Blender {version}: {len(rows)} paints in {time.time() - start:.0f} s; wrote {args.out}")
     return 0
