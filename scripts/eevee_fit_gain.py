@@ -2,7 +2,8 @@
 ``lut.render.eevee.evaluate`` (EEVEE's measured closures) in place of
 ``Closure.evaluate`` (Cycles' formulas), rendered by EEVEE and measured
 against the model like ``scripts/render_fidelity.py`` (the plane oracle of
-addon/scenes.py on its EEVEE grid, cos-weighted relative RMS).
+addon/scenes.py on its EEVEE grid, the fidelity measure ``lut.render.measure``,
+whole and over the grazing band θl >= 60°).
 
     .venv/bin/python scripts/eevee_fit_gain.py [--paints satin matte]
 
@@ -22,26 +23,40 @@ ROOT = pathlib.Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import bpy  # noqa: E402
+import numpy as np  # noqa: E402
 
 from addon import nodes  # noqa: E402
-from addon.scenes import EEVEE, GRID_EEVEE, Oracle, paints, relative_rms  # noqa: E402
+from addon.scenes import EEVEE, GRID_EEVEE, Oracle, grid_points, oracle_errors, paints  # noqa: E402
+from lut.paint.core import Paint  # noqa: E402
 from lut.render import bake as render_bake  # noqa: E402
 from lut.render import eevee, fitting  # noqa: E402
 
 
-def _grams(table, fit, evaluate, grid):
-    """The fit's residual and target Gram matrices on ``grid`` with its
-    closures evaluated by ``evaluate`` (``fitting``'s acceptance error)."""
-    return fitting._acceptance_grams(table, fit.closures, fit.cos_view, fit.weights, evaluate, grid)
+def predicted_errors(table, fit, evaluate, paint, grid):
+    """(whole, grazing band) fidelity measure of ``fit`` at ``paint``'s colours
+    on the oracle's ``grid`` (``addon.scenes.grid_points``) with its closures
+    evaluated by ``evaluate``, through the weights the node group reads,
+    against the paper's model (``fitting.measure_grams``)."""
+    tl, tv, ph = grid_points(paint, grid)
+    kind = Paint.from_dict(table.meta["type"])
+    nodes_ = {k: tuple(table.meta[k]) for k in ("single_nodes", "diffuse_nodes") if k in table.meta}
+    model = (tl, tv, ph), kind.components(tl, tv, ph, **nodes_) * np.cos(tl)[:, None, None]
+    # The weights at the fitted views (every VIEW_SUBDIVISION-th column of the texture).
+    views = fit.weights[:, :, :: fitting.VIEW_SUBDIVISION]
+    cos_view = fit.cos_view[:: fitting.VIEW_SUBDIVISION]
+    whole, band = fitting.measure_grams(model, fit.closures, cos_view, views, evaluate)
+    grams = {"residual": whole[0], "reference": whole[1], "grazing_residual": band[0], "grazing_reference": band[1]}
+    return fitting.reported_errors(grams, table.amplitudes(paint))
 
 
-def rendered_error(oracle, paint, fit, weights_path, label):
-    """EEVEE's relative RMS for ``fit`` wired into a fresh material."""
+def rendered_errors(oracle, paint, fit, weights_path, label):
+    """EEVEE's (whole, grazing band) fidelity measure for ``fit`` wired into a
+    fresh material."""
     fitting.write_fit(fit, weights_path)
     material = oracle.material(label)
     group = nodes.build_group(fit, weights_path)
     nodes.wire(material, {"EEVEE": group}, render_bake.node_inputs(paint, fit.internal_reflectance))
-    return relative_rms(oracle, paint, GRID_EEVEE)
+    return oracle_errors(oracle, paint, GRID_EEVEE)
 
 
 def main(argv=None):
@@ -68,15 +83,18 @@ def main(argv=None):
         for i, (label, fit) in enumerate(variants.items()):
             # The error each fit should have in EEVEE if its closures render as
             # measured, on the rendered grid.
-            res, ref = _grams(table, fit, calibrated, GRID_EEVEE)
-            predicted = fitting.acceptance_error(res, ref, amps)
-            got = rendered_error(oracle, paint, fit, directory / f"fit-{i}-{table.key[:8]}.exr", f"{name} {i}")
+            predicted = predicted_errors(table, fit, calibrated, paint, GRID_EEVEE)
+            got = rendered_errors(oracle, paint, fit, directory / f"fit-{i}-{table.key[:8]}.exr", f"{name} {i}")
+            reported = (fit.error(amps), fit.grazing_error(amps))
             kinds = ", ".join(f"{c.kind}" + (f" r{c.roughness:g}" if c.kind in ("glossy", "metallic") else "")
                               for c in fit.closures)  # fmt: skip
             print(
-                f"{name:13s} {label:26s} EEVEE render {got:.4f}  predicted {predicted:.4f}  [{kinds}]",
+                f"{name:13s} {label:26s} EEVEE render {got[0]:.4f} / {got[1]:.4f}"
+                f"  predicted {predicted[0]:.4f} / {predicted[1]:.4f}"
+                f"  fit reports {reported[0]:.4f} / {reported[1]:.4f}  [{kinds}]",
                 flush=True,
             )
+    print("(each figure: whole measure / grazing band, theta_l >= 60 degrees)")
 
 
 if __name__ == "__main__":

@@ -8,7 +8,7 @@ is one for all views), from EEVEE's measured responses (``lut.render.eevee``).
 For each paint of ``lut.bench.random_paints`` named by its index, it bakes
 the type's LUT and prints the facet component's relative RMS on the fit's
 rows (``lut.render.fitting.light_rows``, the measure the fit minimises) for the
-views of the acceptance range (θv <= 75°): the add-on's fit, and the
+views of the fidelity measure's range (θv <= 75°): the add-on's fit, and the
 per-view best pair out of 15 Glossy roughnesses.  Numpy only."""
 
 from __future__ import annotations

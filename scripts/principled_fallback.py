@@ -5,9 +5,10 @@ colour, IOR n, roughness sqrt(slope), Blender's default multiscatter GGX).
 
     .venv/bin/python scripts/principled_fallback.py [--out FILE.json]
 
-The measure is the acceptance measure (addon/scenes.py): the
-cos-weighted relative RMS of f·cos θl against Paint.brdf · cos θl for
-θl, θv <= 75° away from the mirror direction."""
+The measure is the fidelity measure (``lut.render.measure``) on the
+fallback fit's own grid (``lut.render.principled.GRID``, off the mirror):
+the relative RMS of f·cos θl against Paint.brdf · cos θl, every geometry
+counted once, whole and over the grazing band θl >= 60°."""
 
 from __future__ import annotations
 
@@ -21,7 +22,8 @@ sys.path.insert(0, str(ROOT))
 
 import bpy  # noqa: E402,F401
 
-from addon.scenes import Oracle, paints, principled, principled_params_material, relative_rms  # noqa: E402
+from addon.scenes import Oracle, oracle_errors, paints, principled, principled_params_material  # noqa: E402
+from lut.render import measure  # noqa: E402
 from lut.render import principled as fallback  # noqa: E402
 
 fallback_material = principled_params_material
@@ -33,15 +35,25 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     oracle = Oracle()
     rows = {}
-    print(f"{'paint':16} {'fit':>7} {'Cycles':>7} {'artist':>7}  parameters")
+    points = measure.grid_points(fallback.GRID, measure.MIRROR_EXCLUSION)  # where the fallback is fitted
+    print(f"{'paint':16} {'fit':>7} {'Cycles':>7} {'grazing':>7} {'artist':>7} {'grazing':>7}  parameters")
     for name, paint in paints().items():
         params, error = fallback.fit_principled(paint)
         fallback_material(oracle, params)
-        rendered = relative_rms(oracle, paint)
+        rendered = oracle_errors(oracle, paint, points=points)
         principled(oracle, paint)
-        artist = relative_rms(oracle, paint)
-        rows[name] = {"fit": error, "rendered": rendered, "artist": artist, "params": params.to_dict()}
-        print(f"{name:16} {error:7.4f} {rendered:7.4f} {artist:7.4f}  {params}")
+        artist = oracle_errors(oracle, paint, points=points)
+        rows[name] = {
+            "fit": error,
+            "rendered": rendered[0],
+            "rendered_grazing": rendered[1],
+            "artist": artist[0],
+            "artist_grazing": artist[1],
+            "params": params.to_dict(),
+        }
+        print(
+            f"{name:16} {error:7.4f} {rendered[0]:7.4f} {rendered[1]:7.4f} {artist[0]:7.4f} {artist[1]:7.4f}  {params}"
+        )
     if args.out:
         from lut.lutfiles.files import atomic_write_text
 

@@ -1,15 +1,17 @@
 """Render fidelity of the paint materials: Cycles (Blender 5 and 4.2-4.5
 lobes), EEVEE and the Principled BSDF baseline against the model, on the
-named paints and the randomised acceptance set (the README's fidelity table).
+named paints and the randomised set (the README's fidelity table).
 
     .venv/bin/python scripts/render_fidelity.py [--random 24] [--eevee-random 6] [--out FILE.json]
 
 A plane lit by a Sun and seen by an orthographic camera (addon/scenes.py)
-renders f·E·cos θl; the measure is the cos-weighted relative RMS against
-Paint.brdf · cos θl for θl, θv <= 75° away from the mirror direction.
-Cycles is exact, so its figure is the closure fit's (printed beside it: the
-error the fit reports for the paint, which the panel shows); EEVEE (one
-sample, its own closure approximations, a coarser grid) is not.  The baseline
+renders f·E·cos θl; the measure is the fidelity measure (``lut.render.measure``:
+relative RMS of radiance against Paint.brdf · cos θl, every geometry of a
+subgrid of its grid counted once, a smooth paint's mirror left out), whole
+and over the grazing band θl >= 60° ("<key>_grazing").  Cycles is exact, so
+its figure is the closure fit's (printed beside it: the error the fit reports
+for the paint, which the panel shows); EEVEE (one sample, its own closure
+approximations, a coarser grid) is not.  The baseline
 is a Principled BSDF with the paint's ρ, n and roughness sqrt(slope), after
 the overall scale that suits it best (and as is)."""
 
@@ -28,7 +30,7 @@ import bpy  # noqa: E402,F401
 import numpy as np  # noqa: E402
 
 import addon  # noqa: E402
-from addon.scenes import EEVEE, GRID, GRID_EEVEE, Oracle, paint_material, paints, principled, relative_rms  # noqa: E402
+from addon.scenes import EEVEE, GRID, GRID_EEVEE, Oracle, oracle_errors, paint_material, paints, principled  # noqa: E402
 from lut import bench  # noqa: E402
 from lut.lutfiles import files  # noqa: E402
 
@@ -37,28 +39,31 @@ def measure(paint, directory, eevee=True, lobes_4x=True, baseline=True, cycles=T
     row = {"rough": paint.slope > 0}
     oracle = Oracle()
     _, result = paint_material(oracle, paint, directory)
-    row["cycles_fit"] = result.errors(paint)["CYCLES"]
-    row["eevee_fit"] = result.errors(paint)["EEVEE"]
+    for engine, (whole, grazing) in result.all_errors(paint).items():
+        row[f"{engine.lower()}_fit"], row[f"{engine.lower()}_fit_grazing"] = whole, grazing
     if cycles:
-        row["cycles"] = relative_rms(oracle, paint, GRID)
+        row["cycles"], row["cycles_grazing"] = oracle_errors(oracle, paint, GRID)
     if lobes_4x and cycles and paint.slope > 0:  # Blender 4.2-4.5's facet lobes (Principled, GGX), in 5.x's Cycles
         oracle = Oracle()
         paint_material(oracle, paint, directory, exact_metallic=False)
-        row["cycles_4x"] = relative_rms(oracle, paint, GRID)
+        row["cycles_4x"], row["cycles_4x_grazing"] = oracle_errors(oracle, paint, GRID)
     if eevee:
         oracle = Oracle(engine=EEVEE)
         paint_material(oracle, paint, directory)
-        row["eevee"] = relative_rms(oracle, paint, GRID_EEVEE)
+        row["eevee"], row["eevee_grazing"] = oracle_errors(oracle, paint, GRID_EEVEE)
     if baseline and cycles:
         oracle = Oracle()
         principled(oracle, paint)
-        row["principled"] = relative_rms(oracle, paint, GRID, best_scale=True)
-        row["principled_unscaled"] = relative_rms(oracle, paint, GRID)
+        row["principled"], row["principled_grazing"] = oracle_errors(oracle, paint, GRID, best_scale=True)
+        row["principled_unscaled"], row["principled_unscaled_grazing"] = oracle_errors(oracle, paint, GRID)
     return row
 
 
-def _pct(value):
-    return "" if value is None else f"{value:.2%}"
+def _both(row, key):
+    """A row's figure, whole / grazing band."""
+    if row.get(key) is None:
+        return ""
+    return f"{row[key]:.2%} / {row[key + '_grazing']:.2%}"
 
 
 def main(argv=None) -> int:
@@ -88,25 +93,26 @@ def main(argv=None) -> int:
     files.atomic_write_text(args.out, json.dumps(rows, indent=2) + "\n")
     if args.only_eevee or args.no_eevee:
         print("(a partial run: merge it with the other into the README's table by hand)")
+    print("(each figure: whole measure / grazing band, theta_l >= 60 degrees)")
     print("| paint | Cycles (fit reports) | Cycles, 4.2-4.5 lobes | EEVEE | Principled BSDF: best scale (as is) |")
     print("|---|---|---|---|---|")
     for name, r in rows.items():
         if r.get("random"):
             continue
-        base = f"{r['principled']:.1%} ({r['principled_unscaled']:.1%})" if "principled" in r else ""
+        base = f"{_both(r, 'principled')} ({_both(r, 'principled_unscaled')})" if "principled" in r else ""
         print(
-            f"| {name} | {_pct(r.get('cycles'))} ({_pct(r['cycles_fit'])}) | {_pct(r.get('cycles_4x')) or 'same'} "
-            f"| {_pct(r.get('eevee'))} | {base} |"
+            f"| {name} | {_both(r, 'cycles')} ({_both(r, 'cycles_fit')}) | {_both(r, 'cycles_4x') or 'same'} "
+            f"| {_both(r, 'eevee')} | {base} |"
         )
     print("\nRandomised set (worst / median):")
     for kind in (False, True):
         chosen = [r for r in rows.values() if r.get("random") and r["rough"] == kind]
-        for key in ("cycles", "cycles_4x", "eevee"):
+        for key in ("cycles", "cycles_grazing", "cycles_4x", "cycles_4x_grazing", "eevee", "eevee_grazing"):
             values = [r[key] for r in chosen if key in r]
             if values:
                 label = "rough" if kind else "smooth"
                 print(
-                    f"  {label:6s} {key:10s} n={len(values):2d} worst {max(values):.2%} median {np.median(values):.2%}"
+                    f"  {label:6s} {key:18s} n={len(values):2d} worst {max(values):.2%} median {np.median(values):.2%}"
                 )
     return 0
 
