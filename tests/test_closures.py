@@ -315,18 +315,23 @@ def test_randomised_types_fit_within_their_targets():
     light, smooth to slope 3, both distributions, g of both signs), at the
     paints' own colours, on the fidelity measure against the paper's model,
     whole and over the grazing band, each against its goal
-    (``measure.goals``): the median within three quarters of the goal, and
-    each within the goal up to the measured worst cases (a very rough
-    Gaussian paint and back-scattering smooth ones, README)."""
+    (``measure.goals``): the median within the goal, every smooth paint and
+    every rough one of slope below 1.5 within both goals, and the very rough
+    ones, whose facet terms no Cycles lobe is broad enough to draw (Cycles
+    clamps microfacet roughness to α <= 1 and shadows every lobe:
+    docs/render.md), within twice them."""
     import tempfile
 
-    errors = {"smooth": [], "rough": []}
+    rows = []
     with tempfile.TemporaryDirectory() as directory:
         for _, paint in bench.random_paints(12, seed=7):
-            result = render_bake.bake_for_render(paint, directory, targets=("CYCLES",), resolution=(32, 16, 8))
-            errors["rough" if paint.slope > 0 else "smooth"].append(result.all_errors(paint)["CYCLES"])
-    for kind, values in errors.items():
-        for which, goal in enumerate(measure.goals("CYCLES", kind == "smooth")):
-            figures = [v[which] for v in values]
-            assert np.median(figures) < 0.75 * goal, (kind, which, figures)
-            assert max(figures) < 2.0 * goal, (kind, which, figures)
+            result = render_bake.bake_for_render(paint, directory, targets=("CYCLES",))
+            rows.append((paint, result.all_errors(paint)["CYCLES"]))
+    for smooth in (True, False):
+        chosen = [(p, e) for p, e in rows if (p.slope == 0) == smooth]
+        for which, goal in enumerate(measure.goals("CYCLES", smooth)):
+            figures = [e[which] for _, e in chosen]
+            assert np.median(figures) < goal, (smooth, which, figures)
+            for paint, errors in chosen:
+                allowed = goal if paint.slope < 1.5 else 2.0 * goal
+                assert errors[which] < allowed, (paint, which, errors)
