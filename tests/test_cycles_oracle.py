@@ -132,30 +132,58 @@ def test_named_paints_render_within_target(registered_oracle, name, tmp_path):
     assert grazing < goals[1], (whole, grazing, goals)
 
 
-def test_randomised_paints_render_as_their_fits_promise(registered_oracle, tmp_path):
-    """Twenty paints drawn over the panel's ranges (lut.bench.random_paints,
-    fixed seed), on the fidelity measure, whole and over the grazing band:
-    each rendered by Cycles no more than half a percent above the errors its
-    fit reports and within half a percent plus a tenth of them either way
-    (so the panel's figures are the truth); on the whole measure the median
-    well within the goal, and every paint within its goal except those whose
-    fit reports the miss (the README lists them)."""
-    rows = []
-    for label, paint in bench.random_paints(20):
+#: Every third step of the measure's grid (θl 0-75°, θv 5-65°, φ 0-180° in
+#: 15°, 15° and 30° steps, exact mirrors included): where the oracle checks
+#: that Cycles renders the closures as the fit computes them.
+SUBGRID = tuple(axis[::3] for axis in measure.GRID)
+
+
+def _predicted(result, paint, tl, tv, ph):
+    """The radiance the paint's Cycles fit computes at (θl, θv, φ): its
+    closures' formulas with the weights its texture gives (nearest column)."""
+    fit = result.fits["CYCLES"]
+    values = np.array([c.evaluate(tl, tv, ph) for c in fit.closures])
+    comps = np.einsum("kn,kcnt->ntc", values, fitting.texture_weights(fit.weights, fit.cos_view, np.cos(tv)))
+    amps = result.lut.amplitudes(paint)
+    tiles = comps.shape[1]
+    return np.einsum("nkc,kc->nk", comps[:, [c if tiles == 3 else 0 for c in range(3)], :], amps)
+
+
+def test_randomised_paints_render_as_their_fits_report(registered_oracle, tmp_path):
+    """24 paints over the panel's ranges, the dark facet-dominated corner
+    included (``lut.bench.random_paints(18)`` and ``dark_paints(6)``, fixed
+    seeds), made through the add-on: at every geometry of ``SUBGRID`` Cycles
+    renders the radiance the fit computes, within 0.5% of the model's
+    radiance in RMS.  The fit's reported figures are the measure of exactly
+    that computed radiance against the model on the measure's whole grid
+    (``test_closures``), so by the triangle inequality no render of these
+    paints is worse, or better, than its reported figures by more than
+    0.5%, whole and over the grazing band."""
+    paints = bench.random_paints(18) + bench.dark_paints(6)
+    gaps = {}
+    for label, paint in paints:
         _, result = paint_material(registered_oracle, paint, tmp_path)
-        reported = result.all_errors(paint)["CYCLES"]
-        rendered_both = oracle_errors(registered_oracle, paint)
-        for rendered, predicted in zip(rendered_both, reported, strict=True):
-            assert rendered <= predicted + 0.005, (label, rendered_both, reported)
-            assert abs(rendered - predicted) < 0.005 + 0.1 * predicted, (label, rendered_both, reported)
-        rows.append((label, paint.slope > 0, rendered_both[0], reported[0]))
-    for rough in (False, True):
-        values = [r for _, kind, r, _ in rows if kind == rough]
-        assert np.median(values) < 0.6 * measure.goals("CYCLES", not rough)[0], values
-    misses = [(label, r, p, measure.goals("CYCLES", not rough)[0]) for label, rough, r, p in rows]
-    misses = [m for m in misses if m[1] > m[3]]
-    assert all(p > 0.9 * target for _, _, p, target in misses), misses  # every miss is reported by its fit
-    assert len(misses) <= 1, misses
+        tl, tv, ph = measure.points(paint.slope == 0, SUBGRID)
+        rendered = np.array([registered_oracle.radiance(*g) for g in zip(tl, tv, ph, strict=True)])
+        rendered /= registered_oracle.irradiance
+        model = paint.brdf(tl, tv, ph) * np.cos(tl)[:, None]
+        gaps[label] = float(np.sqrt(np.sum((rendered - _predicted(result, paint, tl, tv, ph)) ** 2) / np.sum(model**2)))
+    assert max(gaps.values()) < 0.005, gaps
+
+
+@pytest.mark.parametrize("index", [5, 20, 21])
+def test_renders_on_the_whole_measure_are_the_reported_figures(registered_oracle, index, tmp_path):
+    """On the measure's whole grid (4,560 renders a paint): a very rough
+    Gaussian paint, a smooth back-scattering one and a near-smooth
+    exponential one (whose near-mirror peak the measure counts at full
+    value) render no worse than their reported figures + 0.5%, and no better
+    than them - 0.5%, whole and over the grazing band."""
+    label, paint = bench.random_paints(24)[index]
+    _, result = paint_material(registered_oracle, paint, tmp_path)
+    reported = result.all_errors(paint)["CYCLES"]
+    rendered = oracle_errors(registered_oracle, paint)
+    for got, promised in zip(rendered, reported, strict=True):
+        assert abs(got - promised) < 0.005, (label, rendered, reported)
 
 
 def test_a_textured_pigment_renders_every_patch_as_its_paint(registered_oracle, tmp_path):
