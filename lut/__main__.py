@@ -30,6 +30,7 @@ from .paint import presets
 from .paint.core import Paint
 from .paint.schema import PAINT_FIELDS, check_range
 from .render import bake as render_bake
+from .render import eevee
 
 DEFAULT_OUT = "out"
 #: The largest LUT the command line bakes: N_u * N_theta_d * N_phi_d nodes
@@ -169,7 +170,25 @@ def _cmd_bake(args) -> int:
     for name, value in render_bake.node_inputs(paint, rbar).items():
         shown = value if isinstance(value, float) else "(" + ", ".join(f"{v:.6g}" for v in value) + ")"
         print(f"  {name}: {shown}")
+    if args.fit:
+        _print_fits(paint, args)
     return 0
+
+
+def _print_fits(paint, args) -> None:
+    """Fit the baked type for Cycles and EEVEE (the newest calibrated
+    Blender line) and print the fidelity measure each fit reports for the
+    paint, whole and over the grazing band, with the goals."""
+    calibration = max(eevee.available_versions(), default=None)
+    options = {k: getattr(args, k) for k in ("resolution", "single_nodes", "diffuse_nodes")}
+    result = render_bake.bake_for_render(paint, args.out, eevee_calibration=calibration, **options)
+    for target, (whole, grazing) in result.all_errors(paint).items():
+        goals = result.fits[target].goals
+        misses = whole > goals[0] or grazing > goals[1]
+        print(
+            f"  {target.title()} fit: {100 * whole:.2f}% (goal {100 * goals[0]:.0f}%), grazing light"
+            f" {100 * grazing:.2f}% (goal {100 * goals[1]:.0f}%){'  MISSES' if misses else ''}"
+        )
 
 
 def _cmd_info(args) -> int:
@@ -287,6 +306,12 @@ def build_parser() -> argparse.ArgumentParser:
             kind = {"type": float}
         b.add_argument(f"--{spec.name}", help=spec.command_line_help(), **kind)
     bake_options(b)
+    b.add_argument(
+        "--fit",
+        action="store_true",
+        help="also fit the closures of Cycles and EEVEE and print the fidelity measure each reports for the paint"
+        " (whole and grazing light, with the goals)",
+    )
 
     info = sub.add_parser("info", help="print LUT files' metadata (and verify their content hashes)")
     info.add_argument("file", nargs="+")

@@ -74,3 +74,27 @@ def test_bad_toml_and_help(tmp_path, capsys):
     assert "is not valid TOML" in capsys.readouterr().err
     run = subprocess.run([sys.executable, "-m", "lut", "bake", "--help"], capture_output=True, text=True)
     assert run.returncode == 0 and "--preset" in run.stdout and "hash of its inputs" in run.stdout
+
+
+def test_bake_with_fit_reports_the_fidelity_measure_of_each_engine(tmp_path, capsys):
+    """``lut bake --fit``: the fidelity measure each engine's fit reports for
+    the paint, whole and over the grazing band, equal to the library's own
+    figures, with the goals; a miss is marked."""
+    import re
+
+    import lut
+    from lut.render import bake as render_bake
+
+    assert main(["bake", "--preset", "glossy_red", "--out", str(tmp_path), "--fit"]) == 0
+    out = capsys.readouterr().out
+    lines = {m[0]: (float(m[1]), float(m[2]), "MISSES" in m[3]) for m in re.findall(
+        r"(Cycles|Eevee) fit: ([\d.]+)% \(goal \d+%\), grazing light ([\d.]+)% \(goal \d+%\)(.*)", out
+    )}  # fmt: skip
+    assert set(lines) == {"Cycles", "Eevee"}
+    paint = lut.preset("glossy_red")
+    result = render_bake.bake_for_render(paint, tmp_path, eevee_calibration=(5, 2))
+    for target, (whole, grazing) in result.all_errors(paint).items():
+        shown = lines[target.title()]
+        assert shown[:2] == pytest.approx((100 * whole, 100 * grazing), abs=0.006)
+        goals = result.fits[target].goals
+        assert shown[2] == (whole > goals[0] or grazing > goals[1])
