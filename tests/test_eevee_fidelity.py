@@ -102,7 +102,7 @@ def test_eevee_renders_the_randomised_set_as_measured(randomised):
     render are the same engine) against the model: bounds a little above
     what this set measures on Blender 5.0 and 5.2 (README), so a broken
     calibration, fit or texture lookup shows.  Smooth paints: the median
-    within 5%; rough: the median within 10%; none beyond 30%.  And the error
+    within 5%; rough: the median within 16%; none beyond 45%.  And the error
     the fit reports (the panel's, on the measure's grid) is not far below
     the render's: within 1.6 times it plus 2%."""
     smooth = [r["eevee"] for r in randomised if r["paint"].slope == 0]
@@ -111,7 +111,9 @@ def test_eevee_renders_the_randomised_set_as_measured(randomised):
     # On the fidelity measure (no cos θl weight: grazing light in full) this
     # set's smooth paints measured 3.5%, 4.2% and 5.4% on Blender 5.0.
     assert np.median(smooth) <= 0.05, smooth
-    assert np.median(rough) <= 0.10, rough
-    assert max(smooth + rough) <= 0.30, smooth + rough
+    # Rough: median 14.6%, worst 42% on that measure (docs/fidelity.md: the
+    # EEVEE column is not re-rendered for the docs yet).
+    assert np.median(rough) <= 0.16, rough
+    assert max(smooth + rough) <= 0.45, smooth + rough
     for row in randomised:
-        assert row["eevee"] <= 1.6 * row["eevee_fit"] + 0.02, row["label"]
+        assert row["eevee"] <= 1.6 * row["eevee_fit"] + 0.02, (row["label"], row["eevee"], row["eevee_fit"])
