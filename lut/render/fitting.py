@@ -77,8 +77,8 @@ TARGET_ERROR = {e: {k: g[0] for k, g in kinds.items()} for e, kinds in measure.G
 #: Closures per material (render cost grows with their number; the mirror
 #: of a smooth type comes on top).  EEVEE evaluates few closures per pixel.
 BUDGET = {"CYCLES": 8, "EEVEE": 3}
-#: Closures a fit may add beyond ``BUDGET`` where a component's acceptance
-#: error is above the target within it: only the types that need them (very
+#: Closures a fit may add beyond ``BUDGET`` where a component misses a goal of
+#: the fidelity measure within it (``shortfall``): only the types that need them (very
 #: rough facets, strongly back-scattering pigments) pay the render cost.
 EXTRA_BUDGET = {"CYCLES": 4, "EEVEE": 0}
 
