@@ -76,6 +76,7 @@ EVERY_KIND = [
     closures.Closure("diffuse_toon", 0.4, 0.3),
     closures.Closure("diffuse_toon", 1e-5, 1.0),
     closures.Closure("glossy_toon", 0.4, 0.3),
+    closures.Closure("glossy_toon", 0.8, 0.3),
     closures.Closure("retro_toon", 0.3, 0.2),
     closures.Closure("glossy", roughness=0.45),
     closures.Closure("sheen", roughness=0.5),
@@ -109,7 +110,15 @@ def test_every_closure_kind_renders_as_its_formula_through_the_node_group(regist
     path = fitting.write_fit(fit, tmp_path / "w.exr")
     material = oracle.material()
     nodes.wire(material, {"CYCLES": nodes.build_group(fit, path)}, UNIT_SINGLE)
-    geometries = ((0.1, 0.4, 0.3), (0.7, 0.4, 0.3), (0.9, 0.5, 0.0), (1.1, 0.8, 0.2), (0.5, 0.6, 2.5), (0.6, 0.55, 3.0))
+    geometries = (
+        (0.1, 0.4, 0.3),
+        (0.7, 0.4, 0.3),
+        (0.9, 0.5, 0.0),
+        (1.1, 0.8, 0.2),
+        (0.5, 0.6, 2.5),
+        (0.6, 0.55, 3.0),
+        (1.2, 1.0, 3.0),
+    )
     for geometry in geometries:
         got = oracle.radiance(*geometry) / oracle.irradiance
         want = float(closure.evaluate(*geometry))
@@ -168,12 +177,8 @@ def test_randomised_paints_render_as_their_fits_report(registered_oracle, tmp_pa
         rendered /= registered_oracle.irradiance
         model = paint.brdf(tl, tv, ph) * np.cos(tl)[:, None]
         gaps[label] = float(np.sqrt(np.sum((rendered - _predicted(result, paint, tl, tv, ph)) ** 2) / np.sum(model**2)))
-    # One paint of the dark set renders 2.0% (of the model's RMS) away from
-    # the radiance its fit computes, measured and not yet explained: held
-    # there so that it cannot grow unseen (docs/fidelity.md).
-    known = {"dark #5 exp 1.0144 g +0.72": 0.025}
     for label, gap in gaps.items():
-        assert gap < known.get(label, 0.005), (label, gaps)
+        assert gap < 0.005, (label, gaps)
 
 
 @pytest.mark.parametrize("index", [5, 20, 21])

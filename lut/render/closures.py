@@ -116,10 +116,15 @@ def _diffuse_toon(closure, theta_l, theta_v, phi):
 
 
 def _glossy_toon(closure, theta_l, theta_v, phi):
-    # Mirror of the view direction: (-sin θv cos φ, -sin θv sin φ, cos θv)
-    # against the light (-sin θl, 0, cos θl).
+    """Cycles' Glossy Toon BSDF: the ramp in the angle between the light and
+    the mirror of the view, (-sin θv cos φ, -sin θv sin φ, cos θv) against
+    (-sin θl, 0, cos θl), dark outside its sampling cone min(size + smooth,
+    90°) (Cycles' bsdf_glossy_toon_eval evaluates only inside that cone: a
+    lobe whose size + smooth passes 90° is cut off there, not ramped on)."""
     cos_rl = np.sin(theta_v) * np.cos(phi) * np.sin(theta_l) + np.cos(theta_v) * np.cos(theta_l)
-    return _toon(np.arccos(np.clip(cos_rl, 0.0, 1.0)), closure.size, closure.smooth)
+    angle = np.arccos(np.clip(cos_rl, 0.0, 1.0))
+    cone = min(np.clip(closure.size, 1e-5, 1.0) + np.clip(closure.smooth, 0.0, 1.0), 1.0) * np.pi / 2
+    return np.where(angle < cone, _toon(angle, closure.size, closure.smooth), 0.0)
 
 
 def _retro_toon(closure, theta_l, theta_v, phi):
