@@ -35,6 +35,10 @@ def _node_tree(material):
     return material.node_tree
 
 
+def _linked(node) -> bool:
+    return any(socket.is_linked for socket in (*node.inputs, *node.outputs))
+
+
 def add_principled_fallback(material, params: principled.PrincipledParams, error: float | None = None):
     """Give ``material`` a Principled BSDF with ``params`` into an active
     Material Output for all engines (created, or updated in place when the
@@ -46,7 +50,20 @@ def add_principled_fallback(material, params: principled.PrincipledParams, error
     tree = _node_tree(material)
     nodes, links = tree.nodes, tree.links
     bsdf = nodes.get(NODE)
-    if bsdf is None or bsdf.type != "BSDF_PRINCIPLED":
+    if bsdf is not None and bsdf.type != "BSDF_PRINCIPLED":
+        bsdf = None
+    # USD's exporter takes the tree's first Principled BSDF, linked or not,
+    # and a new material (Blender 5) holds a default one that the paint's
+    # wiring leaves unlinked: an inert Principled BSDF (no link in or out)
+    # is taken over as the fallback when there is none yet, and removed when
+    # there is, so that the exporter finds the fallback.
+    inert = [nd for nd in nodes if nd.type == "BSDF_PRINCIPLED" and nd != bsdf and not _linked(nd)]
+    if bsdf is None and inert:
+        bsdf = inert.pop(0)
+        bsdf.name = bsdf.label = NODE
+    for orphan in inert:
+        nodes.remove(orphan)
+    if bsdf is None:
         bsdf = nodes.new("ShaderNodeBsdfPrincipled")
         bsdf.name = bsdf.label = NODE
         bsdf.location = (0.0, 400.0)

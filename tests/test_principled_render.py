@@ -116,3 +116,49 @@ def test_fallback_changes_no_engine_render_and_is_exported(oracle, lut_dir, tmp_
         params.roughness, abs=1e-6
     )
     assert float(re.search(r"float inputs:ior = (\S+)", text).group(1)) == pytest.approx(params.ior, abs=1e-5)
+
+
+def _exported_usd(path, name):
+    """(diffuseColor, roughness) of material ``name`` in a .usda file."""
+    text = path.read_text()
+    block = text[text.index(f'def Material "{name}"') :]
+    colour = re.search(r"color3f inputs:diffuseColor = \(([^)]*)\)", block).group(1)
+    return [float(v) for v in colour.split(",")], float(re.search(r"float inputs:roughness = (\S+)", block).group(1))
+
+
+@pytest.mark.parametrize("path", ["api", "panel"])
+def test_a_new_material_exports_its_fallback_not_blenders_default(fresh_file, lut_dir, tmp_path, path):
+    """A material as an artist makes it, through ``api.new_material`` or the
+    panel's bake operator on a new material (Blender 5 gives it a default
+    Principled BSDF that the paint's wiring leaves unlinked): glTF and USD
+    export the paint's fitted fallback, not Blender's default grey."""
+    from addon import api, export
+
+    if path == "api":
+        material = api.new_material("red_paint", lut.preset("glossy_red"), directory=lut_dir, resolution=(8, 6, 4))
+    else:
+        material = bpy.data.materials.new("red_paint")
+        if material.node_tree is None:  # Blender 4.x: the panel's material has its default nodes
+            material.use_nodes = True
+        material.paint_lut.enabled = True
+        material.paint_lut.preset = "glossy_red"
+        bpy.ops.wm.save_as_mainfile(filepath=str(tmp_path / "scene.blend"))
+        with bpy.context.temp_override(material=material):
+            assert bpy.ops.paint_lut.bake("EXEC_DEFAULT") == {"FINISHED"}
+    params, _ = export.fallback_params(material)
+    principled_nodes = [nd for nd in material.node_tree.nodes if nd.type == "BSDF_PRINCIPLED"]
+    assert [nd.name for nd in principled_nodes] == [export.NODE]
+    mesh = bpy.data.meshes.new("plane")
+    mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [(0, 1, 2)])
+    mesh.materials.append(material)
+    bpy.context.scene.collection.objects.link(bpy.data.objects.new("plane", mesh))
+
+    usd = tmp_path / "paint.usda"
+    assert bpy.ops.wm.usd_export(filepath=str(usd)) == {"FINISHED"}
+    colour, roughness = _exported_usd(usd, "red_paint")
+    np.testing.assert_allclose(colour, params.base_color, atol=1e-6)
+    assert roughness == pytest.approx(params.roughness, abs=1e-6)
+    gltf = tmp_path / "paint.gltf"
+    bpy.ops.export_scene.gltf(filepath=str(gltf), export_format="GLTF_SEPARATE")
+    (exported,) = [m for m in json.loads(gltf.read_text())["materials"] if m["name"] == "red_paint"]
+    np.testing.assert_allclose(exported["pbrMetallicRoughness"]["baseColorFactor"][:3], params.base_color, atol=1e-6)
