@@ -77,6 +77,24 @@ def test_every_colour_of_a_type_shares_one_lut(baked, tmp_path):
         table_.evaluate(ti, ts, ps, other)
 
 
+def test_one_paint_type_has_one_key_on_every_machine(tmp_path):
+    """The key hashes what determines a LUT, not what numpy derives from it:
+    r̄ differing in its last bits (numpy 1.26 against 2.x) and a slope of
+    -0.0 against 0.0 (equal paints) give the same file name."""
+    from lut.lutfiles import baking
+
+    paint = PAINTS["satin"]
+    meta = baking.describe(paint)
+    nudged = {**meta, "internal_reflectance": meta["internal_reflectance"] * (1 + 3e-15)}
+    assert nudged != meta and lutfile.cache_key(nudged) == lutfile.cache_key(meta)
+    assert lutfile.cache_key({**meta, "type": {**meta["type"], "n": 1.6}}) != lutfile.cache_key(meta)
+    smooth = dict(n=1.5, rho=(0.2, 0.3, 0.4), g=-0.0)
+    assert lut.Paint(slope=-0.0, **smooth) == lut.Paint(slope=0.0, **smooth)
+    assert baking.lut_path(lut.Paint(slope=-0.0, **smooth), tmp_path) == baking.lut_path(
+        lut.Paint(slope=0.0, g=0.0, n=1.5, rho=(0.2, 0.3, 0.4)), tmp_path
+    )
+
+
 def test_header_describes_the_bake(baked):
     header = lutfile.read_header(baked["satin"])
     meta = header["meta"]

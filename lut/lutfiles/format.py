@@ -137,8 +137,19 @@ def canonical_json(meta: dict) -> str:
     return json.dumps(meta, sort_keys=True, separators=(",", ":"))
 
 
+#: Meta fields derived from the others: recorded in a file (and covered by
+#: its content hash) but not part of its key.  Computed by numpy, their last
+#: bits differ between numpy versions (r̄ reads 0.5959642684316706 under
+#: numpy 1.26 and 0.5959642684316686 under 2.x), and one paint type must
+#: have one key on every machine of a farm.
+DERIVED_FIELDS = ("internal_reflectance",)
+
+
 def cache_key(meta: dict) -> str:
-    return hashlib.sha256(canonical_json(meta).encode()).hexdigest()
+    """The key of a bake's ``meta``: a hash of what determines its content
+    (everything but ``DERIVED_FIELDS``)."""
+    kept = {name: value for name, value in meta.items() if name not in DERIVED_FIELDS}
+    return hashlib.sha256(canonical_json(kept).encode()).hexdigest()
 
 
 def content_hash(meta_json: str, pixels: np.ndarray) -> str:

@@ -206,7 +206,8 @@ class Paint:
             whole = self.to_dict()
             whole.pop("name")
             return whole
-        return {"n": self.n, "g": self.g, "slope": self.slope, "distribution": self.distribution}
+        # + 0.0 turns -0.0 into 0.0: equal paints, one key.
+        return {"n": self.n + 0.0, "g": self.g + 0.0, "slope": self.slope + 0.0, "distribution": self.distribution}
 
     def internal_reflectance(self, diffuse_nodes=DIFFUSE_NODES) -> float:
         """r̄ of the paint's interface (Eq. 22, or its rough counterpart) at
