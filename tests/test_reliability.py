@@ -331,3 +331,18 @@ def test_the_bake_benchmark_writes_no_tracked_file_by_default():
     tracked = subprocess.run(["git", "ls-files", "--error-unmatch", plot], cwd=ROOT, capture_output=True)
     assert tracked.returncode != 0, f"{plot} is a tracked file"
     assert not pathlib.Path(plot).parts[0] == "docs"
+
+
+def test_a_damaged_cached_lut_baked_again_is_reported_computed(tmp_path):
+    """A cached LUT that fails its hash is baked again, and the report says
+    so (not "found cached"); an intact one is reported cached."""
+    from lut.render import bake as render_bake
+
+    paint = lut.Paint(n=1.5, rho=(0.3, 0.3, 0.3))
+    options = {"targets": ("CYCLES",), "resolution": (8, 6, 4)}
+    assert render_bake.bake_for_render(paint, tmp_path, **options).computed == ["lut", "CYCLES"]
+    assert render_bake.bake_for_render(paint, tmp_path, **options).computed == []
+    path = lut.lutfiles.baking.lut_path(paint, tmp_path, resolution=(8, 6, 4))
+    path.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
+    assert render_bake.bake_for_render(paint, tmp_path, **options).computed[0] == "lut"
+    lut.load_lut(path)  # whole again

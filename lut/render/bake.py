@@ -73,6 +73,16 @@ def _cached_fit(path, lut, target, exact_metallic, calibration):
     return fitted
 
 
+def _identity(path):
+    """What tells a file from the one written over it (writes are atomic
+    renames: a new inode), or None when there is none."""
+    try:
+        stat = path.stat()
+    except FileNotFoundError:
+        return None
+    return stat.st_ino, stat.st_mtime_ns, stat.st_size
+
+
 def bake_for_render(
     paint: Paint,
     directory,
@@ -96,13 +106,13 @@ def bake_for_render(
     report = progress or (lambda fraction: None)
     computed = []
     path = baking.lut_path(paint, directory, **lut_options)
-    existed = path.exists()
+    before = _identity(path)
     path = baking.bake(
         paint, directory, force=force, progress=lambda done, total: report(LUT_SHARE * done / max(total, 1)),
         **lut_options,
     )  # fmt: skip
     table = baking.load_lut(path)
-    if force or not existed:
+    if force or before is None or _identity(path) != before:  # a damaged file baked again is computed too
         computed.append("lut")
     report(LUT_SHARE)
     fits, paths = {}, {}
