@@ -148,7 +148,13 @@ def _check_sizes(args) -> None:
     """Resolution and quadrature sizes the machine can bake."""
     if args.resolution is not None:
         nodes = math.prod(args.resolution)
-        if any(r < 2 for r in args.resolution) or nodes > MAX_NODES:
+        for name, size in zip(("N_u", "N_theta_d", "N_phi_d"), args.resolution, strict=True):
+            if not 2 <= size <= 4096:
+                raise ValueError(
+                    f"--resolution: {name} must be a whole number in [2, 4096], got {size} "
+                    f"(in {' '.join(map(str, args.resolution))})"
+                )
+        if nodes > MAX_NODES:
             raise ValueError(
                 f"--resolution must be three whole numbers >= 2 with a product N_u*N_theta_d*N_phi_d of at most "
                 f"{MAX_NODES} (e.g. 256 128 128), got {' '.join(map(str, args.resolution))} ({nodes} nodes)"
@@ -160,8 +166,20 @@ def _check_sizes(args) -> None:
             raise ValueError(f"{option} must be two whole numbers in [1, {MAX_QUADRATURE}], got {list(value)}")
 
 
+def _check_out(out) -> None:
+    """The output folder: a folder (made when missing) that can be written,
+    checked before any work."""
+    out = pathlib.Path(out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out must be a folder, got a file: {out}")
+    existing = next((p for p in (out, *out.parents) if p.exists()), None)
+    if existing is not None and not os.access(existing, os.W_OK | os.X_OK):
+        raise ValueError(f"--out {out}: cannot write into {existing} (permission denied)")
+
+
 def _cmd_bake(args) -> int:
     _check_sizes(args)
+    _check_out(args.out)
     paint = _paint_from_args(args)
     path, seconds = _bake_one(paint, args.out, args, paint.name or "bake")
     print(f"{path}  ({seconds:.2f} s)")
@@ -313,6 +331,7 @@ def build_parser() -> argparse.ArgumentParser:
         " (whole and grazing light, with the goals)",
     )
 
+    parser.bake_parser = b  # its own usage line for errors found after parsing
     info = sub.add_parser("info", help="print LUT files' metadata (and verify their content hashes)")
     info.add_argument("file", nargs="+")
 
@@ -342,9 +361,9 @@ def main(argv=None) -> int:
                     setattr(args, key, [float(v) for v in value])
                 except ValueError:
                     if len(value) != 1:
-                        parser.error(f"--{key} takes one grey value, three RGB values or one spectrum")
+                        parser.bake_parser.error(f"--{key} takes one grey value, three RGB values or one spectrum")
             elif value is not None:
-                parser.error(f"--{key} takes one grey value, three RGB values or one spectrum")
+                parser.bake_parser.error(f"--{key} takes one grey value, three RGB values or one spectrum")
     command = {"example": _cmd_example, "bake": _cmd_bake, "info": _cmd_info, "clean": _cmd_clean}[args.command]
     try:
         return command(args)

@@ -138,6 +138,7 @@ def _error_line(capsys):
     [
         (["--resolution", "4096", "4096", "4096"], "product N_u*N_theta_d*N_phi_d of at most 4194304"),
         (["--resolution", "1024", "1024", "8"], "got 1024 1024 8 (8388608 nodes)"),
+        (["--resolution", "4096", "1024", "1"], "N_phi_d must be a whole number in [2, 4096], got 1"),
         (["--single-nodes", "1000", "1000"], "--single-nodes must be two whole numbers in [1, 64]"),
         (["--n", "1e6"], "n must be in [1, 4], got 1000000.0"),
         (["--slope", "1e300"], "slope must be 0 (smooth) or in [0.001, 3], got 1e+300"),
@@ -346,3 +347,25 @@ def test_a_damaged_cached_lut_baked_again_is_reported_computed(tmp_path):
     path.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
     assert render_bake.bake_for_render(paint, tmp_path, **options).computed[0] == "lut"
     lut.load_lut(path)  # whole again
+
+
+def test_an_index_given_as_a_numpy_scalar_is_a_number():
+    assert lut.Paint(n=np.float32(1.5), rho=0.5).n == pytest.approx(1.5)
+    with pytest.raises(ValueError, match=r"n must be a finite real number > 0, got -1.0"):
+        lut.Paint(n=np.float64(-1.0), rho=0.5)
+
+
+def test_out_that_is_a_file_is_refused_before_any_work(tmp_path, capsys):
+    target = tmp_path / "a_file"
+    target.write_text("kept")
+    assert main(["bake", *SMALL, "--out", str(target)]) == 2
+    assert _error_line(capsys) == f"error: --out must be a folder, got a file: {target}"
+    assert target.read_text() == "kept"
+
+
+def test_a_colour_of_two_values_gets_the_bake_commands_usage(tmp_path, capsys):
+    with pytest.raises(SystemExit) as exit_:
+        main(["bake", "--rho", "0.1", "0.2", "--out", str(tmp_path)])
+    assert exit_.value.code == 2
+    err = capsys.readouterr().err
+    assert "usage: python -m lut bake" in err and "--rho takes one grey value, three RGB values" in err

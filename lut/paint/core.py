@@ -24,6 +24,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import numbers
 from typing import Any
 
 import numpy as np
@@ -99,8 +100,8 @@ def _colour_value(value, name: str):
 def _index(value):
     """n: a number > 0, or Cauchy coefficients (A, B[, C...]) giving
     n(λ) = A + B/λ² + C/λ⁴ + ... with λ in µm."""
-    if isinstance(value, (int, float)) and not isinstance(value, bool):
-        return PAINT_FIELDS["n"].check(value)
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):  # numpy's scalars too
+        return PAINT_FIELDS["n"].check(float(value))
     try:
         coeffs = tuple(float(c) for c in value)
     except (TypeError, ValueError):
