@@ -16,6 +16,7 @@ import json
 import math
 import os
 import pathlib
+import re
 import sys
 import time
 import tomllib
@@ -223,7 +224,22 @@ def _cmd_info(args) -> int:
         if i:
             print()
         _print_info(file, header)
+        named = _named_key(file)
+        if named is not None and not header["key"].startswith(named):
+            print(
+                f"error: {file}: its name says key {named} but it holds the LUT of key {header['key'][:24]} "
+                "(copied or renamed from another paint type's file)",
+                file=sys.stderr,
+            )
+            status = 2
     return status
+
+
+def _named_key(file):
+    """The key prefix a LUT file's name gives (``paintlut-<key>.exr``), or
+    None for a name of another form."""
+    match = re.fullmatch(r"paintlut-([0-9a-f]{24})\.exr", pathlib.Path(file).name)
+    return match.group(1) if match else None
 
 
 def _print_info(file, header) -> None:
@@ -238,6 +254,7 @@ def _print_info(file, header) -> None:
         if key in meta:
             print(f"  {key:15} {meta[key]}")
     print(f"  content hash    {header['hash']} (verified)")
+    print(f"  key             {header['key']}")
     print("  paint type (every colour of it shares this LUT):")
     for key, value in meta["type"].items():
         if isinstance(value, dict):

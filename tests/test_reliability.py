@@ -228,6 +228,23 @@ def test_info_takes_several_files(tmp_path, capsys):
     assert str(luts[0]) in captured.out and "missing.exr: no such LUT file" in captured.err
 
 
+def test_info_checks_a_lut_files_name_against_its_key(tmp_path, capsys):
+    """A LUT copied under another type's name is whole (its hash verifies)
+    but not what its name says: info says so and fails; a file under any
+    other name is not judged by its name."""
+    one = lut.bake(lut.Paint(rho=0.5), tmp_path, resolution=(8, 6, 4))
+    other = lut.bake(lut.Paint(n=1.7, rho=0.5), tmp_path, resolution=(8, 6, 4))
+    other.write_bytes(one.read_bytes())
+    assert main(["info", str(one)]) == 0
+    capsys.readouterr()
+    assert main(["info", str(other)]) == 2
+    err = capsys.readouterr().err
+    assert f"its name says key {other.name[9:33]}" in err and "another paint type" in err
+    renamed = tmp_path / "mine.exr"
+    renamed.write_bytes(one.read_bytes())
+    assert main(["info", str(renamed)]) == 0
+
+
 def test_info_into_a_closed_pipe_is_quiet(tmp_path):
     path = lut.bake(lut.Paint(rho=0.5), tmp_path, resolution=(8, 6, 4))
     read_end, write_end = os.pipe()
