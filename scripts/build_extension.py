@@ -165,9 +165,28 @@ def run(command: list[str]) -> None:
         raise SystemExit(f"error: {' '.join(command[-4:])} failed:\n{done.stdout}{done.stderr}")
 
 
+def untracked(root: pathlib.Path = ROOT) -> list[str]:
+    """Files the zip would pack (lut/, addon/) that git does not track: a
+    build packs what the repository holds, not what lies in a working copy.
+    Empty outside a git checkout (a source archive holds only tracked files)."""
+    done = subprocess.run(
+        ["git", "ls-files", "--others", "--exclude-standard", "--", "lut", "addon"],
+        cwd=root, capture_output=True, text=True,
+    )  # fmt: skip
+    if done.returncode != 0:
+        return []
+    return [name for name in done.stdout.splitlines() if name.endswith((".py", ".blend", ".txt", ".toml"))]
+
+
 def build(output_dir, blender: str | None = None) -> pathlib.Path:
-    """Build and validate the extension zip; returns its path."""
+    """Build and validate the extension zip; returns its path.  Refuses a
+    working copy with untracked sources (``untracked``)."""
     check_versions()
+    stray = untracked()
+    if stray:
+        raise SystemExit(
+            "error: untracked files would go into the extension: " + ", ".join(stray) + " (commit or remove them)"
+        )
     output_dir = pathlib.Path(output_dir).resolve()
     output_dir.mkdir(parents=True, exist_ok=True)
     target = output_dir / f"{manifest()['id']}-{manifest()['version']}.zip"

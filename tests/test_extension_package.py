@@ -202,3 +202,18 @@ def test_installs_offline_into_a_clean_user_directory_and_renders(package, tmp_p
     model = [float(v) for v in out["MODEL"].split()]
     for r, m in zip(rendered, model, strict=True):
         assert abs(r - m) <= 0.05 * max(model), (rendered, model)
+
+
+def test_a_working_copy_with_untracked_sources_is_refused(tmp_path):
+    """An untracked module in lut/ would go into the wheel: the build names
+    it and stops before writing anything."""
+    stray = ROOT / "lut" / "zz_untracked_for_test.py"
+    stray.write_text("X = 1\n")
+    try:
+        assert "lut/zz_untracked_for_test.py" in build_extension.untracked()
+        with pytest.raises(SystemExit, match="untracked files would go into the extension: .*zz_untracked_for_test"):
+            build_extension.build(tmp_path / "dist")
+    finally:
+        stray.unlink()
+    assert not (tmp_path / "dist").exists()
+    assert "lut/zz_untracked_for_test.py" not in build_extension.untracked()
