@@ -31,6 +31,7 @@ import importlib
 import json
 import os
 import pathlib
+import re
 import subprocess
 import sys
 import tempfile
@@ -177,6 +178,8 @@ def bake_file(path, force=False, pack=False, **options) -> dict:
     entry = {"file": str(path), "materials": {}}
     try:
         check_blend(path)
+        if not path.stat().st_mode & 0o222:  # by its mode bits: root may write anything
+            raise ValueError(f"{path} is read-only: not baked or saved (make it writable to bake it)")
         bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
     except (ValueError, RuntimeError) as exc:
         entry.update(status="failed", reason=str(exc).strip())
@@ -197,14 +200,33 @@ def bake_file(path, force=False, pack=False, **options) -> dict:
         try:
             save_atomically(path, pack=pack)
         except (OSError, RuntimeError) as exc:
-            entry.update(status="failed", reason=f"cannot save {path}: {exc}")
+            # Blender's message names the hidden temporary file: name the file.
+            message = re.sub(r"\S*\.partial\.blend\S*", path.name, str(exc)).strip()
+            entry.update(status="failed", reason=f"cannot save {path}: {message}")
+            for m in entry["materials"].values():
+                if m["status"] == "baked":  # its bake is not in the file
+                    m.update(status="failed", reason="baked, but the file could not be saved")
             return entry
         entry["status"] = "saved"
     else:
         entry["status"] = "unchanged"
-    if any(_failed(m) for m in entry["materials"].values()):
-        entry["reason"] = "some materials failed or are not baked in their library"
+    reason = _materials_reason(entry["materials"])
+    if reason:
+        entry["reason"] = reason
     return entry
+
+
+def _materials_reason(materials) -> str:
+    """What failed among a file's materials, by name: those that failed, and
+    the linked ones whose library holds no current bake."""
+    failed_names = [name for name, m in materials.items() if m["status"] == "failed"]
+    unbaked = [name for name, m in materials.items() if m["status"] == "linked" and not m.get("baked")]
+    parts = []
+    if failed_names:
+        parts.append(f"{len(failed_names)} failed ({', '.join(failed_names)})")
+    if unbaked:
+        parts.append(f"{len(unbaked)} linked, not baked in their library ({', '.join(unbaked)})")
+    return "; ".join(parts)
 
 
 def _failed(material_entry) -> bool:
@@ -225,9 +247,13 @@ def summary(entries) -> str:
         counts = {}
         for m in entry["materials"].values():
             counts[m["status"]] = counts.get(m["status"], 0) + 1
-        text = ", ".join(f"{v} {k}" for k, v in sorted(counts.items())) or "no paint materials"
+        text = ", ".join(f"{v} {k}" for k, v in sorted(counts.items()))
+        if not text and entry["status"] != "failed":  # a failed file may not have been read at all
+            text = "no paint materials"
         lines.append(
-            f"{entry['file']}: {entry['status']} ({text})" + (f": {entry['reason']}" if "reason" in entry else "")
+            f"{entry['file']}: {entry['status']}"
+            + (f" ({text})" if text else "")
+            + (f": {entry['reason']}" if "reason" in entry else "")
         )
         for name, m in entry["materials"].items():
             if m["status"] in ("failed", "linked"):

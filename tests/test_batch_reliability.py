@@ -223,6 +223,7 @@ def test_a_material_whose_bake_raises_anything_fails_alone(tmp_path, monkeypatch
     assert entry["materials"]["broken"] == {"status": "failed", "reason": "ZeroDivisionError: float division by zero"}
     assert entry["materials"]["spectral"]["status"] == "failed"
     assert "spectrum scale must be a finite real number >= 0, got None" in entry["materials"]["spectral"]["reason"]
+    assert entry["reason"] == "2 failed (broken, spectral)"  # by name, and nothing said of libraries
     bpy.ops.wm.open_mainfile(filepath=str(blend))
     assert addon.nodes.group_of(bpy.data.materials["good"]) is not None  # its bake was saved
 
@@ -257,6 +258,44 @@ def test_saving_keeps_the_blend_permissions(tmp_path, mode):
     blend.chmod(mode)
     assert batch.bake_file(blend)["status"] == "saved"
     assert stat.S_IMODE(blend.stat().st_mode) == mode
+
+
+def test_a_read_only_blend_is_reported_and_never_written(tmp_path):
+    """A 0444 file in a writable folder stays as it is, --force or not."""
+    scene = new_file()
+    scene.collection.objects.link(triangle("red", paint_material("red")))
+    blend = save(tmp_path / "kept.blend")
+    blend.chmod(0o444)
+    before = blend.read_bytes()
+    entry = batch.bake_file(blend, force=True)
+    assert entry["status"] == "failed" and "kept.blend is read-only: not baked or saved" in entry["reason"]
+    assert blend.read_bytes() == before and stat.S_IMODE(blend.stat().st_mode) == 0o444
+    assert not (tmp_path / "paint_lut").exists()
+
+
+def test_a_file_that_cannot_be_saved_lists_no_material_baked(tmp_path, monkeypatch):
+    """When the .blend cannot be written, its bakes are not in it: the
+    materials are failed, and the reason names the file, not the hidden
+    temporary one."""
+    scene = new_file()
+    scene.collection.objects.link(triangle("red", paint_material("red")))
+    blend = save(tmp_path / "shot.blend")
+
+    def refuse(filepath):
+        raise RuntimeError(f"Error: Cannot open file {filepath} for writing: No space left on device")
+
+    monkeypatch.setattr(batch, "_write_blend", refuse)
+    entry = batch.bake_file(blend)
+    assert entry["status"] == "failed" and ".partial" not in entry["reason"]
+    assert entry["reason"].startswith(f"cannot save {blend}: Error: Cannot open file shot.blend for writing")
+    assert entry["materials"]["red"]["status"] == "failed"
+    assert entry["materials"]["red"]["reason"] == "baked, but the file could not be saved"
+
+
+def test_a_file_that_cannot_be_read_is_not_said_to_have_no_paint_materials(tmp_path):
+    missing = batch.bake_file(tmp_path / "missing.blend")
+    text = batch.summary([missing])
+    assert text.startswith(f"{tmp_path / 'missing.blend'}: failed: ") and "no paint materials" not in text
 
 
 def test_parallel_jobs_leave_no_temporary_directory(tmp_path):
