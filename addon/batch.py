@@ -74,10 +74,16 @@ def _write_blend(filepath):
 
 def materials_to_bake(scenes) -> set:
     """The materials a file must bake: those its scenes render
-    (``api.used_materials``) and its own material assets (an asset kept with
-    a fake user for other files to link is used, here in its own file)."""
-    assets = {m for m in bpy.data.materials if m.library is None and m.asset_data is not None}
-    return api.used_materials(scenes) | assets
+    (``api.used_materials``), its own material assets (an asset kept with
+    a fake user for other files to link is used, here in its own file), and
+    its materials kept by a fake user alone (a library of the classic,
+    pre-asset kind: other files link them)."""
+    kept = {
+        m
+        for m in bpy.data.materials
+        if m.library is None and (m.asset_data is not None or (m.use_fake_user and m.users == 1))
+    }
+    return api.used_materials(scenes) | kept
 
 
 def _report_name(material) -> str:

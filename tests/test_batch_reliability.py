@@ -194,6 +194,20 @@ def test_linked_paint_is_baked_in_its_library_and_reported_linked_elsewhere(tmp_
     assert entry["materials"]["asset paint"]["status"] == "cached"
 
 
+def test_a_library_of_materials_kept_by_fake_users_is_baked(tmp_path):
+    """The classic library (before assets): paint materials no object uses,
+    kept by a fake user for other files to link.  They are baked there, as
+    assets are; a material nothing keeps is still unused."""
+    new_file()
+    kept = paint_material("kept paint")
+    kept.use_fake_user = True
+    paint_material("orphan paint")  # saved by nobody but this test's save
+    library = save(tmp_path / "classic.blend")
+    statuses = {n: m["status"] for n, m in batch.bake_file(library)["materials"].items()}
+    assert statuses.get("kept paint") == "baked"
+    assert statuses.get("orphan paint", "unused") == "unused"
+
+
 # ----------------------------------------------------------------------------- one bad material fails alone
 
 
