@@ -40,6 +40,7 @@ import bpy
 
 from . import api, nodes
 from ._lut import closures, files, fitting, lut
+from .library import ASSETS
 
 #: The first bytes of a .blend file: plain, gzip (Blender < 3) or zstd compressed.
 _MAGIC = (b"BLENDER", b"\x1f\x8b", b"\x28\xb5\x2f\xfd")
@@ -86,6 +87,14 @@ def materials_to_bake(scenes) -> set:
     return api.used_materials(scenes) | kept
 
 
+def bundled(path) -> bool:
+    """Whether ``path`` is in the add-on's own asset library folder: a file
+    the batch links from but never writes (it ships with the extension, saved
+    by the oldest Blender the extension supports)."""
+    path = pathlib.Path(os.path.realpath(path))
+    return path.parent == pathlib.Path(os.path.realpath(ASSETS))
+
+
 def _report_name(material) -> str:
     """A material's key in the report: its name, or for a linked one its
     name and library ("paint [lib.blend]"), which a local one may share."""
@@ -99,6 +108,12 @@ def linked_status(material, exact_metallic=None) -> dict:
     ``api.bake_material`` takes it) and the node groups are there and
     verified)."""
     library = pathlib.Path(bpy.path.abspath(material.library.filepath)).resolve()
+    if bundled(library):
+        return {
+            "status": "linked", "library": str(library), "baked": False, "bundled": True,
+            "reason": "linked from the add-on's bundled library: renders its Principled fallback "
+            "(append the material to bake it in this file)",
+        }  # fmt: skip
     settings = material.paint_lut
     baked = False
     if not settings.stale and settings.lut_path:
@@ -184,6 +199,10 @@ def bake_file(path, force=False, pack=False, **options) -> dict:
     entry = {"file": str(path), "materials": {}}
     try:
         check_blend(path)
+        if bundled(path):
+            raise ValueError(
+                f"{path} is the add-on's own asset library: never written (append its materials to bake them)"
+            )
         if not path.stat().st_mode & 0o222:  # by its mode bits: root may write anything
             raise ValueError(f"{path} is read-only: not baked or saved (make it writable to bake it)")
         bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
@@ -226,7 +245,7 @@ def _materials_reason(materials) -> str:
     """What failed among a file's materials, by name: those that failed, and
     the linked ones whose library holds no current bake."""
     failed_names = [name for name, m in materials.items() if m["status"] == "failed"]
-    unbaked = [name for name, m in materials.items() if m["status"] == "linked" and not m.get("baked")]
+    unbaked = [name for name, m in materials.items() if _unbaked_link(m)]
     parts = []
     if failed_names:
         parts.append(f"{len(failed_names)} failed ({', '.join(failed_names)})")
@@ -235,9 +254,15 @@ def _materials_reason(materials) -> str:
     return "; ".join(parts)
 
 
+def _unbaked_link(material_entry) -> bool:
+    """A link to a library that holds no current bake (the bundled library's
+    materials keep their fallback, as documented: not a failure)."""
+    m = material_entry
+    return m["status"] == "linked" and not m.get("baked") and not m.get("bundled")
+
+
 def _failed(material_entry) -> bool:
-    status = material_entry["status"]
-    return status == "failed" or (status == "linked" and not material_entry.get("baked"))
+    return material_entry["status"] == "failed" or _unbaked_link(material_entry)
 
 
 def failed(entries) -> bool:

@@ -80,7 +80,8 @@ def set_material_tree(material):
 
 def make_instancing_blend(path):
     """'instanced' only through a collection instance, 'geonodes' only
-    through a Geometry Nodes Set Material, 'spare' on nothing."""
+    through a Geometry Nodes Set Material, 'spare' on a mesh no object
+    shows."""
     scene = new_file()
     hidden = bpy.data.collections.new("props")  # not in the scene: rendered only through the instance
     hidden.objects.link(triangle("prop", paint_material("instanced")))
@@ -91,7 +92,9 @@ def make_instancing_blend(path):
     plain = triangle("plain")
     plain.modifiers.new("paint", "NODES").node_group = set_material_tree(paint_material("geonodes", (0.7, 0.2, 0.1)))
     scene.collection.objects.link(plain)
-    paint_material("spare").use_fake_user = True
+    spare = bpy.data.meshes.new("spare mesh")  # on a mesh no object shows: not rendered
+    spare.materials.append(paint_material("spare"))
+    spare.use_fake_user = True
     return save(path)
 
 
@@ -206,6 +209,29 @@ def test_a_library_of_materials_kept_by_fake_users_is_baked(tmp_path):
     statuses = {n: m["status"] for n, m in batch.bake_file(library)["materials"].items()}
     assert statuses.get("kept paint") == "baked"
     assert statuses.get("orphan paint", "unused") == "unused"
+
+
+def test_links_into_the_bundled_library_keep_their_fallback_and_it_is_never_written(tmp_path):
+    """A paint linked from the add-on's own asset library is reported as
+    keeping its fallback without failing the run, and the batch refuses to
+    write that library (nor a paint_lut folder beside it)."""
+    from addon import library
+
+    scene = new_file()
+    with bpy.data.libraries.load(str(library.LIBRARY_BLEND), link=True) as (_, linked):
+        linked.materials = ["Satin"]
+    scene.collection.objects.link(triangle("wall", linked.materials[0]))
+    shot = save(tmp_path / "shot.blend")
+    entry = batch.bake_file(shot)
+    (satin,) = entry["materials"].values()
+    assert satin["status"] == "linked" and satin["bundled"] is True and "Principled fallback" in satin["reason"]
+    assert not batch.failed([entry]) and "reason" not in entry
+
+    before = library.LIBRARY_BLEND.stat().st_mtime_ns
+    listing = sorted(library.ASSETS.iterdir())
+    entry = batch.bake_file(library.LIBRARY_BLEND, force=True)
+    assert entry["status"] == "failed" and "the add-on's own asset library: never written" in entry["reason"]
+    assert library.LIBRARY_BLEND.stat().st_mtime_ns == before and sorted(library.ASSETS.iterdir()) == listing
 
 
 # ----------------------------------------------------------------------------- one bad material fails alone
