@@ -5,7 +5,7 @@ from __future__ import annotations
 import bpy
 
 from . import api
-from .properties import MATERIAL_FIELDS
+from .properties import MATERIAL_FIELDS, seen_limit
 
 
 def draw_settings(layout, material):
@@ -17,6 +17,9 @@ def draw_settings(layout, material):
     col.use_property_decorate = False
     col.label(text="Colours (live: no bake)")
     col.prop(settings, "seen")
+    limit = seen_limit(settings)
+    if limit is not None:
+        col.label(text=seen_limit_text(limit), icon="INFO")
     for spec in MATERIAL_FIELDS:  # the colours and weights (lut.paint.schema)
         if not spec.shapes_type:
             col.prop(settings, spec.name)
@@ -32,6 +35,11 @@ def draw_settings(layout, material):
         layout.label(text=bpy.path.basename(settings.lut_path), icon="CHECKMARK")
         for target, fit in api.fit_errors(material).items():
             layout.label(text=fit_error_text(target, fit), icon="ERROR" if fit.missed else "CHECKMARK")
+
+
+def seen_limit_text(limit: float) -> str:
+    """The panel's note when "Color as Seen" is at its most (``seen_limit``)."""
+    return f"Seen colour capped at {limit:.2f}: a white pigment shows no more through the binder"
 
 
 def fit_error_text(target, fit) -> str:

@@ -133,6 +133,16 @@ def _get_seen(self):
     return tuple(float(v) for v in lut.render.bake.seen_of_pigment(tuple(self.rho), albedo, rbar))
 
 
+def seen_limit(settings):
+    """The most a channel of "Color as Seen" can show, a_D (what a white
+    pigment shows head-on through the binder's interface: the light is
+    transmitted in and out: 1 - R(0) = 0.96 under a smooth binder of n = 1.5,
+    less under a rough one), when some channel is at it (its pigment at 1, so a larger
+    value asked was capped there); None otherwise."""
+    albedo, _ = _seen_constants(settings)
+    return albedo if max(settings.rho) >= 1.0 - 1e-6 else None
+
+
 def _set_seen(self, value):
     albedo, rbar = _seen_constants(self)
     self.rho = tuple(float(v) for v in lut.render.bake.pigment_of_seen(value, albedo, rbar))

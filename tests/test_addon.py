@@ -510,6 +510,26 @@ def test_colour_as_seen_sets_the_pigment_that_shows_it(material, lut_dir):
     }
 
 
+def test_a_seen_colour_beyond_white_pigment_is_capped_and_says_so(material, lut_dir):
+    """ "Color as Seen" (1, 1, 1) cannot be shown through the binder: the
+    pigment goes to white, the colour reads back a_D, and the panel's note
+    says what it was capped at and why."""
+    from addon import api, panels, properties
+
+    api.bake_material(material, directory=lut_dir)
+    settings = material.paint_lut
+    settings.seen = (0.5, 0.2, 0.05)
+    assert properties.seen_limit(settings) is None
+    settings.seen = (1.0, 1.0, 1.0)
+    assert tuple(settings.rho) == pytest.approx((1.0, 1.0, 1.0))
+    assert tuple(settings.seen) == pytest.approx((settings.diffuse_albedo,) * 3, abs=1e-6)
+    limit = properties.seen_limit(settings)
+    assert limit == pytest.approx(0.96, abs=2e-4)
+    assert panels.seen_limit_text(limit) == (
+        "Seen colour capped at 0.96: a white pigment shows no more through the binder"
+    )
+
+
 def test_a_type_edited_during_a_background_bake_stays_stale(material, tmp_path):
     """The operator's background bake finishes after the artist changed the
     slope: the material is wired to what was baked but stays stale; a colour
