@@ -14,6 +14,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import json
+import sys
 
 import bpy
 
@@ -24,11 +25,26 @@ from .live import working_space
 #: The paint fields a material stores (in ``lut.Paint``'s order).
 MATERIAL_FIELDS = tuple(spec for spec in schema.PAINT_FIELDS.values() if spec.on_material)
 
+#: The preset menu, each item with its stored number (files keep the number:
+#: Custom 0, the paper's samples 1-3, Spectral 4).
 PRESET_ITEMS = [
-    ("CUSTOM", "Custom", "Paint given by the fields below"),
-    *((name, name.replace("_", " ").title(), f"The paper's {name.replace('_', ' ')} sample") for name in lut.PRESETS),
-    ("SPECTRAL", "Spectral", "A spectral paint stored from Python (addon.api.set_paint); the fields show its RGB"),
-]
+    ("CUSTOM", "Custom", "Paint given by the fields below", 0),
+    *(
+        (name, name.replace("_", " ").title(), f"The paper's {name.replace('_', ' ')} sample", number)
+        for number, name in enumerate(lut.PRESETS, start=1)
+    ),
+    ("SPECTRAL", "Spectral", "The spectral paint stored from Python (addon.api.set_paint); the fields show its RGB",
+     len(lut.PRESETS) + 1),
+]  # fmt: skip
+#: The menu of a material with no spectral paint stored: Spectral would have nothing to show.
+_PRESET_ITEMS_RGB = PRESET_ITEMS[:-1]
+
+
+def _preset_items(self, context):
+    """Spectral is offered only where a spectral paint is stored (module-level
+    lists: Blender keeps no reference to what a callback returns)."""
+    return PRESET_ITEMS if self.spectral_paint else _PRESET_ITEMS_RGB
+
 
 _applying_preset = False
 
@@ -67,8 +83,11 @@ def _send_colours(settings):
 def _preset_changed(self, context):
     before = self.type_key()
     if self.preset == "SPECTRAL":
-        if self.spectral_paint:
+        try:
             set_fields(self, self.to_paint())
+        except ValueError as exc:  # a stored paint that is not valid: said once, baked never
+            print(f"Paint LUT: {self.id_data.name}: {exc}", file=sys.stderr)
+            self.stale = True
     elif self.preset != "CUSTOM":
         set_fields(self, lut.preset(self.preset, working_space()))
     if self.type_key() != before or not self.lut_path:
@@ -153,7 +172,7 @@ class PaintLUTSettings(bpy.types.PropertyGroup):
         name="Use Paint LUT", default=False, description="Render this material as a Paint LUT paint",
     )  # fmt: skip
     preset: bpy.props.EnumProperty(
-        name="Preset", items=PRESET_ITEMS, default="CUSTOM", update=_preset_changed,
+        name="Preset", items=_preset_items, default=0, update=_preset_changed,
         description="One of the paper's three paints, or Custom",
     )  # fmt: skip
     lut_path: bpy.props.StringProperty(
@@ -191,7 +210,10 @@ class PaintLUTSettings(bpy.types.PropertyGroup):
         """The lut.Paint these settings describe (a preset's exact spectral
         paint while the preset is selected)."""
         space = space or working_space()
-        if self.preset == "SPECTRAL":
+        # "" where a file stores Spectral but no spectral paint (the menu no
+        # longer offers it): the fields are the paint.
+        preset = self.preset or "CUSTOM"
+        if preset == "SPECTRAL":
             if not self.spectral_paint:
                 raise ValueError("preset 'Spectral' needs a spectral paint stored with addon.api.set_paint")
             try:
@@ -199,8 +221,8 @@ class PaintLUTSettings(bpy.types.PropertyGroup):
             except ValueError:
                 raise ValueError("the stored spectral paint is not valid JSON; store it again with set_paint") from None
             return dataclasses.replace(lut.Paint.from_dict(data), space=space)
-        if self.preset != "CUSTOM":
-            return lut.preset(self.preset, space)
+        if preset != "CUSTOM":
+            return lut.preset(preset, space)
         fields = {}
         for spec in MATERIAL_FIELDS:
             value = getattr(self, spec.name)

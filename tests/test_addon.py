@@ -631,3 +631,27 @@ def test_the_panel_shows_every_material_field_colours_first(material):
     fields = [spec.name for spec in properties.MATERIAL_FIELDS]
     assert [p for p in layout.props if p in fields] == ["rho", "single", "facet", "n", "g", "slope", "distribution"]
     assert layout.props[:3] == ["enabled", "preset", "seen"]
+
+
+def test_the_spectral_preset_is_offered_only_with_a_stored_spectrum(material, capfd):
+    """With no spectral paint stored the menu has no Spectral; picking it
+    over a stored paint that is not valid says so in one line (no
+    traceback) and leaves the material to be baked, which then names the
+    problem."""
+    from addon import api, properties
+
+    settings = material.paint_lut
+    offered = [item[0] for item in properties._preset_items(settings, bpy.context)]
+    assert "SPECTRAL" not in offered and "CUSTOM" in offered
+    with pytest.raises(TypeError):
+        settings.preset = "SPECTRAL"
+    settings.spectral_paint = json.dumps({"rho": {"spectrum": "no such spectrum"}})
+    offered = [item[0] for item in properties._preset_items(settings, bpy.context)]
+    assert "SPECTRAL" in offered
+    capfd.readouterr()
+    settings.preset = "SPECTRAL"
+    err = capfd.readouterr().err
+    assert "Traceback" not in err and err.count("\n") == 1 and err.startswith(f"Paint LUT: {material.name}: ")
+    assert settings.stale
+    with pytest.raises(ValueError, match="spectrum"):
+        api.paint_of(material)

@@ -6,6 +6,7 @@ after it is appended into an unsaved file."""
 from __future__ import annotations
 
 import importlib.util
+import json
 import pathlib
 
 import pytest
@@ -188,10 +189,11 @@ def test_a_failed_first_bake_is_recorded_not_raised(fresh_file, lut_dir):
     from addon import library
 
     material = _load({"Glossy White"})["Glossy White"]
-    material.paint_lut.preset = "SPECTRAL"  # with no spectral paint stored: cannot be baked
+    material.paint_lut.spectral_paint = json.dumps({"rho": {"spectrum": "no such spectrum"}})
+    material.paint_lut.preset = "SPECTRAL"  # a stored spectral paint that is not valid: cannot be baked
     status = library.bake_pending(directory=lut_dir)
     assert status["Glossy White"].startswith("failed: ")
-    assert library.FIRST_USE not in material and "spectral" in material[library.ERROR]
+    assert library.FIRST_USE not in material and "unknown spectrum" in material[library.ERROR]
     assert library.pending() == []
 
 
