@@ -386,3 +386,15 @@ def test_a_colour_of_two_values_gets_the_bake_commands_usage(tmp_path, capsys):
     assert exit_.value.code == 2
     err = capsys.readouterr().err
     assert "usage: python -m lut bake" in err and "--rho takes one grey value, three RGB values" in err
+
+
+def test_a_damaged_file_gives_one_line_not_the_libraries_raw_errors(tmp_path):
+    """OpenEXR's core prints a raw line per damaged chunk: a truncated LUT
+    gives the one error naming it, and nothing else, on stderr."""
+    pytest.importorskip("OpenImageIO")
+    path = lut.bake(lut.Paint(rho=0.5), tmp_path, resolution=(32, 16, 8))
+    path.write_bytes(path.read_bytes()[: path.stat().st_size // 3])
+    done = subprocess.run([sys.executable, "-m", "lut", "info", str(path)], capture_output=True, text=True, cwd=ROOT)
+    assert done.returncode == 2
+    assert done.stderr.count("\n") == 1 and done.stderr.startswith(f"error: {path}"), done.stderr
+    assert "EXR_ERR" not in done.stderr

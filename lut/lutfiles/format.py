@@ -26,9 +26,14 @@ malformed file, whatever the damage, raises LUTError naming it.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import json
+import os
 import pathlib
+import sys
+import tempfile
+import threading
 
 import numpy as np
 
@@ -108,22 +113,68 @@ def _read_any(path, keys, prefix):
         if prefix:
             found.update((k, v) for k, v in attrs.items() if k.startswith(prefix))
         return pixels, found
-    inp = oiio.ImageInput.open(str(path))
-    if inp is None:
-        raise LUTError(f"{path}: not a readable EXR image (truncated or corrupt?): {oiio.geterror()}")
-    try:
-        spec = inp.spec()
-        attrs = {key: _attribute(spec, key, path) for key in keys}
-        if prefix:
-            names = [p.name for p in spec.extra_attribs if p.name.startswith(prefix)]
-            attrs.update((name, _attribute(spec, name, path)) for name in names)
-        pixels = inp.read_image(oiio.FLOAT)
-        error = inp.geterror()
-    finally:
-        inp.close()
+    with _stderr_kept() as printed:
+        inp = oiio.ImageInput.open(str(path))
+        if inp is None:
+            raise LUTError(f"{path}: not a readable EXR image (truncated or corrupt?): {oiio.geterror()}")
+        try:
+            spec = inp.spec()
+            attrs = {key: _attribute(spec, key, path) for key in keys}
+            if prefix:
+                names = [p.name for p in spec.extra_attribs if p.name.startswith(prefix)]
+                attrs.update((name, _attribute(spec, name, path)) for name in names)
+            pixels = inp.read_image(oiio.FLOAT)
+            error = inp.geterror()
+        finally:
+            inp.close()
     if pixels is None or np.ndim(pixels) != 3 or error:
         raise LUTError(f"{path}: pixel data cannot be read (truncated file?): {error or oiio.geterror()}")
+    if printed:  # a file that reads whole: what the libraries printed is news, pass it on
+        sys.stderr.write(printed[0])
     return np.asarray(pixels, dtype=np.float32), attrs
+
+
+@contextlib.contextmanager
+def _stderr_kept():
+    """Hold what native code prints on file descriptor 2 while a file is
+    read: OpenEXR's core prints a raw line per damaged chunk (dozens for one
+    truncated file) before OpenImageIO reports the one error that the
+    ``LUTError`` gives.  Yields a list that holds the text after the block
+    (passed on by the caller when the read succeeds).  Where descriptor 2
+    cannot be redirected, nothing is held."""
+    held = []
+    with _STDERR_LOCK:  # one redirection at a time: threads read files too
+        try:
+            sys.stderr.flush()
+            saved = os.dup(2)
+        except (OSError, ValueError):
+            yield held
+            return
+        with _held_into(saved) as sink:
+            yield held
+        if sink:
+            held.append(sink[0])
+
+
+_STDERR_LOCK = threading.RLock()
+
+
+@contextlib.contextmanager
+def _held_into(saved):
+    """Descriptor 2 into a temporary file for the block, then back to
+    ``saved`` (closed after); yields a list that gets the file's text."""
+    text = []
+    with tempfile.TemporaryFile() as sink:
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield text
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+            sink.seek(0)
+            printed = sink.read().decode(errors="replace")
+            if printed:
+                text.append(printed)
 
 
 def _attribute(spec, key, path):
