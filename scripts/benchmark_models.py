@@ -4,28 +4,46 @@ paper's random-pairs method for comparison).
 
     .venv/bin/python scripts/benchmark_models.py [--quick]
 
-SCATMECH's per-call cost comes from scripts/data/scatmech_speed.json
-(measured by scripts/scatmech_speed.py where pySCATMECH is installed)."""
+SCATMECH's per-call cost is timed in the same run, on the same machine
+(scripts/scatmech_speed.py, run by this interpreter or by the one given with
+--scatmech-python, which has pySCATMECH); where there is none, the table has
+no ratio: a cost stored from another machine is not compared with local
+timings."""
 
 from __future__ import annotations
 
 import argparse
 import json
 import pathlib
+import subprocess
 import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
 
 from lut import bench  # noqa: E402
 
-BASELINE = pathlib.Path(__file__).parent / "data" / "scatmech_speed.json"
+SPEED = pathlib.Path(__file__).parent / "scatmech_speed.py"
+
+
+def scatmech_cost(python):
+    """pySCATMECH's microseconds per evaluation, timed now by ``python``
+    (None: this interpreter), or None where that Python has no pySCATMECH."""
+    done = subprocess.run(
+        [python or sys.executable, str(SPEED)], capture_output=True, text=True, cwd=SPEED.parent
+    )  # fmt: skip
+    if done.returncode != 0:
+        return None
+    return json.loads(done.stdout)["microseconds_per_evaluation"]
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--quick", action="store_true", help="a smaller table (32x32x16) and fewer settings")
+    parser.add_argument("--scatmech-python", metavar="PYTHON", help="a Python with pySCATMECH, to time it here")
     args = parser.parse_args(argv)
-    scatmech = json.loads(BASELINE.read_text())["microseconds_per_evaluation"]
+    scatmech = scatmech_cost(args.scatmech_python)
+    if scatmech is None:
+        print("pySCATMECH not found (give --scatmech-python): the table has no ratio to SCATMECH\n")
 
     count = 20_000 if args.quick else 100_000
     for grid in (False, True):
@@ -34,6 +52,9 @@ def main(argv=None):
         print(f"{'model':20} {'SCATMECH us':>12} {'full us':>9} {'M00 us':>8} {'vs SCATMECH':>12} {'full/M00':>9}")
         for name, row in bench.throughput(count, grid=grid).items():
             full, m00 = row["full"] * 1e6, row["m00"] * 1e6
+            if scatmech is None:
+                print(f"{name:20} {'-':>12} {full:9.3f} {m00:8.3f} {'-':>12} {full / m00:9.1f}")
+                continue
             ratio = scatmech[name] / full
             print(f"{name:20} {scatmech[name]:12.2f} {full:9.3f} {m00:8.3f} {ratio:11.0f}x {full / m00:9.1f}")
         print()

@@ -2,8 +2,9 @@
 
     .venv/bin/python scripts/figures.py [--out DIR]
 
-Writes fig1.png, fig2_white.png, fig2_red.png and fig3_carc.png (default
-directory docs/figures, which the README shows).  See lut/figures.py."""
+Writes fig1.png, fig2_white.png, fig2_red.png and fig3_carc.png into DIR
+(default: figures/ in the current folder, so a trial run never replaces the
+documented ones; ``--out docs/figures`` makes those).  See lut/figures.py."""
 
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ from lut import figures  # noqa: E402
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--out", default="docs/figures", help="output directory (default: %(default)s)")
+    parser.add_argument("--out", default="figures", help="output directory (default: %(default)s)")
     args = parser.parse_args(argv)
     for path in figures.all_figures(args.out):
         print(path)

@@ -1,6 +1,10 @@
 """Render the three preset paints side by side in Cycles (the README's picture).
 
-    .venv/bin/python scripts/render_presets.py [--out docs/figures/presets.png] [--samples N]
+    .venv/bin/python scripts/render_presets.py [--out presets.png] [--samples N]
+
+The README's picture is made with ``--out docs/figures/presets.png``; by
+default the picture goes to the current folder, so a trial run never
+replaces the documented one.
 
 Three spheres on a grey floor (addon.scenes.presets_scene), each material
 made by the add-on's headless API (addon.api.new_material: bake, closure
@@ -28,7 +32,7 @@ from lut.lutfiles import files  # noqa: E402
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--out", default=str(ROOT / "docs" / "figures" / "presets.png"))
+    parser.add_argument("--out", default="presets.png", help="the picture (default: %(default)s, here)")
     parser.add_argument("--samples", type=int, default=128)
     parser.add_argument("--size", type=int, nargs=2, default=(960, 360), metavar=("W", "H"))
     args = parser.parse_args(argv)
