@@ -32,3 +32,15 @@ def test_readme_pictures_and_scripts_exist():
     assert {"scripts/build_extension.py", "scripts/batch_bake.py", "scripts/render_fidelity.py"} <= scripts
     missing = [p for p in [*pictures, *scripts] if not (ROOT / p).is_file()]
     assert not missing, missing
+
+
+def test_scripts_never_write_the_documented_pictures_by_default():
+    """A trial run of a picture script leaves docs/figures alone (the docs
+    give --out for the real ones), and the model benchmark compares only
+    timings it takes itself."""
+    for script in ("render_presets.py", "figures.py"):
+        source = (ROOT / "scripts" / script).read_text()
+        (default,) = re.findall(r'"--out", default=([^,)]+)', source)
+        assert "docs" not in default, (script, default)
+    assert not (ROOT / "scripts" / "data" / "scatmech_speed.json").exists()
+    assert "scatmech_cost(" in (ROOT / "scripts" / "benchmark_models.py").read_text()
