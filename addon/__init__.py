@@ -5,13 +5,14 @@ physics and file formats are in ``lut``.  A bake writes the paint's LUT and
 per-view closure fits (Cycles, EEVEE) and wires them into the material as
 node groups (``nodes``); ``api`` and ``batch`` are the headless entry points.
 ``library`` registers the bundled paint materials as an asset library and
-bakes each one on its first use."""
+bakes each one on its first use; ``saving`` takes an unsaved file's bakes
+along on its first save."""
 
 import bpy
 
-from . import library, operators, panels, properties
+from . import library, operators, panels, properties, saving
 
-_MODULES = (properties, operators, panels, library)
+_MODULES = (properties, operators, panels, library, saving)
 
 
 def _expose_openimageio():

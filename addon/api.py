@@ -30,6 +30,11 @@ def lut_directory() -> pathlib.Path:
     when the add-on runs outside an extension)."""
     if bpy.data.filepath:
         return pathlib.Path(bpy.path.abspath(LUT_DIRECTORY))
+    return user_lut_directory()
+
+
+def user_lut_directory() -> pathlib.Path:
+    """Where an unsaved file's bakes go (``lut_directory``)."""
     package = __package__ or "addon"
     try:
         return pathlib.Path(bpy.utils.extension_path_user(package, path="paint_lut", create=True))

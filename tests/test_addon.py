@@ -655,3 +655,32 @@ def test_the_spectral_preset_is_offered_only_with_a_stored_spectrum(material, ca
     assert settings.stale
     with pytest.raises(ValueError, match="spectrum"):
         api.paint_of(material)
+
+
+def test_the_first_save_takes_an_unsaved_files_bakes_along(fresh_file, tmp_path):
+    """Baked before the file had a path (into the user folder), a material's
+    LUT and weights are copied beside the file on its first save, and the
+    saved file points at them relative to itself: current in the panel, and
+    found cached by the next batch (nothing rebaked)."""
+    from addon import api, batch
+
+    assert not bpy.data.filepath
+    material = api.new_material("unsaved paint", lut.Paint(n=1.5, rho=(0.2, 0.5, 0.3)))  # smooth: quick
+    assert pathlib.Path(material.paint_lut.lut_path).parent == api.user_lut_directory()
+    mesh = bpy.data.meshes.new("tri")
+    mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [(0, 1, 2)])
+    mesh.materials.append(material)
+    bpy.context.scene.collection.objects.link(bpy.data.objects.new("tri", mesh))
+    blend = tmp_path / "first.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(blend))
+
+    bpy.ops.wm.open_mainfile(filepath=str(blend))
+    material = bpy.data.materials["unsaved paint"]
+    settings = material.paint_lut
+    assert settings.lut_path.startswith("//paint_lut/paintlut-") and not settings.stale
+    assert (tmp_path / settings.lut_path.removeprefix("//")).is_file()
+    weights = [image.filepath for image in bpy.data.images if image.filepath.endswith(".exr")]
+    assert weights and all(path.startswith("//paint_lut/paintfit-") for path in weights)
+    assert all((tmp_path / path.removeprefix("//")).is_file() for path in weights)
+    entry = batch.bake_file(blend)
+    assert entry["materials"]["unsaved paint"]["status"] == "cached", entry
