@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
+import contextlib
 import importlib
 import json
 import os
@@ -85,6 +86,26 @@ def materials_to_bake(scenes) -> set:
         if m.library is None and (m.asset_data is not None or (m.use_fake_user and m.users == 1))
     }
     return api.used_materials(scenes) | kept
+
+
+@contextlib.contextmanager
+def _blender_chatter_to_stderr():
+    """Blender prints "Read blend: ..." on standard output when it opens a
+    file: send it to standard error for the block, so the batch's standard
+    output is its summary alone."""
+    try:
+        sys.stdout.flush()
+        saved = os.dup(1)
+    except (OSError, ValueError):
+        yield
+        return
+    try:
+        os.dup2(2, 1)
+        yield
+    finally:
+        sys.stdout.flush()
+        os.dup2(saved, 1)
+        os.close(saved)
 
 
 def bundled(path) -> bool:
@@ -205,7 +226,8 @@ def bake_file(path, force=False, pack=False, **options) -> dict:
             )
         if not path.stat().st_mode & 0o222:  # by its mode bits: root may write anything
             raise ValueError(f"{path} is read-only: not baked or saved (make it writable to bake it)")
-        bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
+        with _blender_chatter_to_stderr():
+            bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
     except (ValueError, RuntimeError) as exc:
         entry.update(status="failed", reason=str(exc).strip())
         return entry

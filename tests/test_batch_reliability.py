@@ -107,6 +107,7 @@ def test_materials_rendered_through_instances_and_geometry_nodes_are_baked(tmp_p
     report = tmp_path / "report.json"
     done = run(blend, "--report", report)
     assert done.returncode == 0, done.stderr
+    assert "Read blend" not in done.stdout and "Read blend" in done.stderr  # stdout: the summary alone
     materials = report_of(report)[0]["materials"]
     assert {k: m["status"] for k, m in materials.items()} == {
         "instanced": "baked",
