@@ -398,3 +398,17 @@ def test_a_damaged_file_gives_one_line_not_the_libraries_raw_errors(tmp_path):
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and done.stderr.startswith(f"error: {path}"), done.stderr
     assert "EXR_ERR" not in done.stderr
+
+
+def test_a_folder_that_refuses_writes_is_named_not_the_hidden_file(tmp_path, monkeypatch):
+    """When the folder refuses the temporary file (read-only, full), the
+    error names the file asked for and its folder."""
+    import tempfile
+
+    def refuse(**kwargs):
+        raise PermissionError(13, "Permission denied", str(tmp_path / ".a.123@host.x.partial.exr"))
+
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
+    with pytest.raises(PermissionError, match=r"cannot write a\.exr into .*: Permission denied") as error:
+        files.atomic_write_bytes(tmp_path / "a.exr", b"x")
+    assert ".partial" not in str(error.value)

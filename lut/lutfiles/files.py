@@ -107,9 +107,12 @@ def atomic_target(path):
         mode = stat.S_IMODE(path.stat().st_mode)
     except FileNotFoundError:
         mode = _new_file_mode()
-    fd, tmp = tempfile.mkstemp(
-        dir=path.parent, prefix=f".{path.stem}.{os.getpid()}@{_host()}.", suffix=f".partial{path.suffix}"
-    )
+    try:
+        fd, tmp = tempfile.mkstemp(
+            dir=path.parent, prefix=f".{path.stem}.{os.getpid()}@{_host()}.", suffix=f".partial{path.suffix}"
+        )
+    except OSError as exc:  # name the file asked for, not the hidden temporary one
+        raise type(exc)(exc.errno, f"cannot write {path.name} into {path.parent}: {exc.strerror}") from None
     os.close(fd)
     try:
         yield tmp
