@@ -344,3 +344,21 @@ def test_randomised_types_fit_within_their_targets():
             for paint, errors in chosen:
                 allowed = goal if paint.slope < 1.5 else 2.0 * goal
                 assert errors[which] < allowed, (paint, which, errors)
+
+
+def test_the_batched_spd_solver_is_numpys_solve():
+    """``nnls.solve_spd`` (elimination over a batch, no LAPACK call per
+    matrix) agrees with numpy's solve on random positive definite systems,
+    regularised near-singular ones and 1x1 ones."""
+    from lut.render.nnls import solve_spd
+
+    rng = np.random.default_rng(11)
+    m = rng.normal(size=(40, 6, 9, 5))  # rank 5 in 9 unknowns: singular without the ridge
+    a = m @ np.swapaxes(m, -1, -2) + 1e-10 * np.eye(9)
+    b = np.einsum("...ij,...j->...i", a, rng.normal(size=(40, 6, 9)))
+    np.testing.assert_allclose(np.einsum("...ij,...j->...i", a, solve_spd(a, b)), b, atol=1e-8 * np.abs(b).max())
+    m = rng.normal(size=(30, 7, 7))
+    a = m @ np.swapaxes(m, -1, -2) + 0.1 * np.eye(7)
+    b = rng.normal(size=(30, 7))
+    np.testing.assert_allclose(solve_spd(a, b), np.linalg.solve(a, b[..., None])[..., 0], rtol=1e-10, atol=1e-12)
+    assert solve_spd(np.array([[4.0]]), np.array([2.0])) == pytest.approx([0.5])

@@ -63,7 +63,7 @@ from ..lutfiles import format as lutfile
 from ..paint.core import COMPONENTS, reference_index
 from . import closures, measure
 from .closures import Closure
-from .nnls import nnls_gram_batch
+from .nnls import nnls_gram_batch, solve_spd
 
 #: Fit format version: bumped when the weights file layout or the fit changes.
 #: It is part of the weights file's name (``fit_path``), so a new release
@@ -385,7 +385,7 @@ def _ls_errors(gram, rhs, norm, base, cands):
     g = rhs[:, idx]  # (M, Kc, s)
     scale = np.maximum(np.abs(np.diagonal(sub, axis1=-2, axis2=-1)).max(axis=-1), 1e-300)
     sub = sub + 1e-10 * scale[..., None, None] * np.eye(idx.shape[1])
-    x = np.linalg.solve(sub, g[..., None])[..., 0]
+    x = solve_spd(sub, g)
     err = norm[:, 0, None] - np.sum(x * g, axis=-1)
     return _relative(np.maximum(err, 0.0), norm)
 
@@ -419,7 +419,7 @@ def _nnls_fit(gram, rhs, norm, idx, upper):
     scale = np.maximum(np.abs(np.diagonal(sub, axis1=-2, axis2=-1)).max(axis=-1), 1e-300)
     # Unconstrained solutions first (all views at once); NNLS only where a
     # weight leaves its bounds.
-    x = np.linalg.solve(sub + 1e-13 * scale[:, None, None] * np.eye(len(idx)), g[..., None])[..., 0]
+    x = solve_spd(sub + 1e-13 * scale[:, None, None] * np.eye(len(idx)), g)
     bad = (np.any(x < 0, axis=1) | np.any(x > upper, axis=1)) & (norm[:, 0] > 0)
     if bad.any():
         x[bad] = nnls_gram_batch(sub[bad], g[bad], upper=upper)
