@@ -186,17 +186,16 @@ def test_renders_on_the_whole_measure_are_the_reported_figures(registered_oracle
     """On the measure's whole grid (4,560 renders a paint): a very rough
     Gaussian paint, a smooth back-scattering one and a near-smooth
     exponential one (whose near-mirror peak the measure counts at full
-    value) render no worse than their reported figures + 0.5%, whole and
-    over the grazing band, and no better than them by more than 1% (the
-    smooth back-scattering paint's grazing band renders 7.83% against a
-    reported 8.39%)."""
+    value) render their reported figures within 0.5%, whole and over the
+    grazing band, neither worse nor better (all 24 of the set render within
+    0.02% of theirs: scripts/data/oracle_fidelity-random.json)."""
     label, paint = bench.random_paints(24)[index]
     _, result = paint_material(registered_oracle, paint, tmp_path)
     reported = result.all_errors(paint)["CYCLES"]
     rendered = oracle_errors(registered_oracle, paint)
     for got, promised in zip(rendered, reported, strict=True):
         assert got <= promised + 0.005, (label, rendered, reported)
-        assert got >= promised - 0.01, (label, rendered, reported)
+        assert got >= promised - 0.005, (label, rendered, reported)
 
 
 def test_a_textured_pigment_renders_every_patch_as_its_paint(registered_oracle, tmp_path):
