@@ -428,16 +428,24 @@ def _nnls_fit(gram, rhs, norm, idx, upper):
     return x, float(_relative(np.maximum(err, 0.0), norm))
 
 
-def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None):
+def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None, start=()):
     """Forward selection of closures for every (tile, component) target.
     gram (M, K, K); rhs (M, P, K), norm (M, P, 2) over P targets; allowed
     (P, K); upper (K,); caps: (mask over K, most closures of the mask);
-    goal: the relative squared error below which selection stops.  Returns
-    the chosen closure indices in order."""
+    goal: the relative squared error below which selection stops; start:
+    closures chosen already (the steps a selection within a smaller budget
+    shares with this one: ``shared``).  Returns (the chosen closure indices
+    in order, how many of the first of them any larger budget would choose
+    too: those picked while no candidate was out of the budget)."""
     targets = [p for p in range(rhs.shape[1]) if norm[:, p, 0].sum() > 0]
-    chosen: list[int] = []
+    chosen: list[int] = list(start)
     errors = {p: 1.0 for p in targets}
-    spent = 0
+    for p in targets:
+        idx = [k for k in chosen if allowed[p, k]]
+        if idx:
+            errors[p] = _nnls_fit(gram, rhs[:, p], norm[:, p], idx, upper[idx])[1]
+    spent = int(sum(cost[k] for k in chosen))
+    shared = None if spent + cost.max() <= budget else len(chosen)
     while targets:
         if max(errors.values()) < goal:
             break
@@ -454,6 +462,8 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None):
         ]
         if not cands:
             break
+        if shared is None and spent + cost.max() > budget:
+            shared = len(chosen)  # from here on the budget may exclude a candidate
         proxy = np.zeros(len(cands))
         for p in targets:
             base = [k for k in chosen if allowed[p, k]]
@@ -482,7 +492,7 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None):
         chosen.append(best)
         spent += cost[best]
         errors = best_errors
-    return chosen
+    return chosen, len(chosen) if shared is None else shared
 
 
 # ---------------------------------------------------------------------- fit
@@ -705,12 +715,16 @@ def _fit_rows(lut, target, evaluate, basis, theta_v, theta_l, phi, row_w, model,
     def score(whole, band):
         return shortfall(whole, band, goals)
 
-    chosen = _select(gram, rhs, norm, allowed, upper, cost, budget, goal**2, caps)
+    chosen, shared = _select(gram, rhs, norm, allowed, upper, cost, budget, goal**2, caps)
     basis_kept, weights, whole, band = weights_of(chosen)
     if extra_budget > 0 and score(whole, band) > 1.0:
         # Some colour of this type misses a goal: select again with the
-        # extra closures, and keep that choice if it misses by less.
-        more = weights_of(_select(gram, rhs, norm, allowed, upper, cost, budget + extra_budget, goal**2, caps))
+        # extra closures (from the steps both budgets take alike), and keep
+        # that choice if it misses by less.
+        wider, _ = _select(
+            gram, rhs, norm, allowed, upper, cost, budget + extra_budget, goal**2, caps, start=chosen[:shared]
+        )
+        more = weights_of(wider)
         if score(*more[2:]) < score(whole, band):
             basis_kept, weights, whole, band = more
     return basis_kept, weights, whole, band, score(whole, band)

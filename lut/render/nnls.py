@@ -122,11 +122,15 @@ def _batch_active_set(gram, rhs, excluded, max_iter=None):
     eye = np.eye(n)
     max_iter = max_iter or 3 * n + 3
 
-    def solve(passive):
-        mask = passive[:, :, None] & passive[:, None, :]
-        sub = np.where(mask, gram, 0.0) + np.where(passive, 1e-13 * scale[:, None], 1.0)[:, :, None] * eye
-        z = solve_spd(sub, np.where(passive, rhs, 0.0))
-        return np.where(passive, z, 0.0)
+    def solve(passive, rows):
+        """The passive set's least squares solution of the problems ``rows``
+        (the others, finished, are left at zero: not solved again)."""
+        p = passive[rows]
+        mask = p[:, :, None] & p[:, None, :]
+        sub = np.where(mask, gram[rows], 0.0) + np.where(p, 1e-13 * scale[rows, None], 1.0)[:, :, None] * eye
+        z = np.zeros((b, n))
+        z[rows] = np.where(p, solve_spd(sub, np.where(p, rhs[rows], 0.0)), 0.0)
+        return z
 
     x = np.zeros((b, n))
     passive = np.zeros((b, n), dtype=bool)
@@ -139,11 +143,12 @@ def _batch_active_set(gram, rhs, excluded, max_iter=None):
         if not active.any():
             break
         passive[np.flatnonzero(active), j[active]] = True
+        pending = active.copy()  # the problems whose passive set is not yet feasible
         for _inner in range(3 * n + 3):
-            z = solve(passive)
+            z = solve(passive, np.flatnonzero(pending))
             neg = passive & (z <= 0)
-            bad = active & neg.any(axis=1)
-            good = active & ~bad
+            bad = pending & neg.any(axis=1)
+            good = pending & ~bad
             x[good] = z[good]
             if not bad.any():
                 break
@@ -153,4 +158,5 @@ def _batch_active_set(gram, rhs, excluded, max_iter=None):
             passive &= ~(bad[:, None] & (x <= tol[:, None] / scale[:, None]))
             x = np.where(passive, x, 0.0)
             active &= passive.any(axis=1) | ~bad
+            pending = bad & active
     return x
