@@ -261,3 +261,24 @@ def test_files_without_openimageio(tmp_path, monkeypatch):
     _refuses_truncated_and_junk(without, tmp_path)
     monkeypatch.undo()
     np.testing.assert_array_equal(lut.load_lut(without).data, a.data)  # OpenImageIO reads ours
+
+
+def test_a_lut_keyed_by_its_whole_meta_still_reads(tmp_path, monkeypatch):
+    """Files written when r̄ was part of the key (the previous release) stay
+    readable; a key that is neither is refused."""
+    import hashlib
+
+    table, header = lutfile.read(lut.bake(PAINTS["smooth"], tmp_path))
+    meta = header["meta"]
+    legacy = hashlib.sha256(lutfile.canonical_json(meta).encode()).hexdigest()
+    assert legacy != lutfile.cache_key(meta)
+    real_key = lutfile.cache_key
+    for key, readable in ((legacy, True), ("0" * 64, False)):
+        monkeypatch.setattr(lutfile, "cache_key", lambda m, key=key: key)
+        path = lutfile.write(tmp_path / "written.exr", table, meta)
+        monkeypatch.setattr(lutfile, "cache_key", real_key)
+        if readable:
+            assert lutfile.read(path)[1]["key"] == legacy
+        else:
+            with pytest.raises(lut.LUTError, match="header key does not match its meta"):
+                lutfile.read(path)
