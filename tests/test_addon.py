@@ -684,3 +684,21 @@ def test_the_first_save_takes_an_unsaved_files_bakes_along(fresh_file, tmp_path)
     assert all((tmp_path / path.removeprefix("//")).is_file() for path in weights)
     entry = batch.bake_file(blend)
     assert entry["materials"]["unsaved paint"]["status"] == "cached", entry
+
+
+def test_a_save_copy_of_an_unsaved_file_leaves_the_session_as_it_was(fresh_file, tmp_path):
+    """Save Copy writes a complete file, but the session stays unsaved: its
+    material keeps pointing at the bakes where they are."""
+    from addon import api
+
+    material = api.new_material("copied paint", lut.Paint(n=1.5, rho=(0.6, 0.5, 0.3)))
+    material.use_fake_user = True  # saved though no object uses it
+    before = material.paint_lut.lut_path
+    images = {image.name: image.filepath for image in bpy.data.images}
+    copy = tmp_path / "copy.blend"
+    bpy.ops.wm.save_as_mainfile(filepath=str(copy), copy=True)
+    assert not bpy.data.filepath and material.paint_lut.lut_path == before
+    assert {image.name: image.filepath for image in bpy.data.images} == images
+    assert api.is_current(material, api.paint_of(material), directory=api.user_lut_directory())
+    bpy.ops.wm.open_mainfile(filepath=str(copy))
+    assert bpy.data.materials["copied paint"].paint_lut.lut_path.startswith("//paint_lut/paintlut-")
