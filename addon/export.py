@@ -39,6 +39,26 @@ def _linked(node) -> bool:
     return any(socket.is_linked for socket in (*node.inputs, *node.outputs))
 
 
+def _values(node) -> list:
+    return [
+        tuple(s.default_value) if hasattr(s.default_value, "__len__") else s.default_value
+        for s in node.inputs
+        if hasattr(s, "default_value")
+    ]
+
+
+def _pristine(node, tree) -> bool:
+    """A Principled BSDF as Blender makes it: no link in or out and every
+    input at the new node's default."""
+    if _linked(node):
+        return False
+    reference = tree.nodes.new("ShaderNodeBsdfPrincipled")
+    try:
+        return node.distribution == reference.distribution and _values(node) == _values(reference)
+    finally:
+        tree.nodes.remove(reference)
+
+
 def add_principled_fallback(material, params: principled.PrincipledParams, error: float | None = None):
     """Give ``material`` a Principled BSDF with ``params`` into an active
     Material Output for all engines (created, or updated in place when the
@@ -54,10 +74,11 @@ def add_principled_fallback(material, params: principled.PrincipledParams, error
         bsdf = None
     # USD's exporter takes the tree's first Principled BSDF, linked or not,
     # and a new material (Blender 5) holds a default one that the paint's
-    # wiring leaves unlinked: an inert Principled BSDF (no link in or out)
-    # is taken over as the fallback when there is none yet, and removed when
-    # there is, so that the exporter finds the fallback.
-    inert = [nd for nd in nodes if nd.type == "BSDF_PRINCIPLED" and nd != bsdf and not _linked(nd)]
+    # wiring leaves unlinked: such a node (no link in or out, every input at
+    # its default) is taken over as the fallback when there is none yet, and
+    # removed when there is, so that the exporter finds the fallback.  A
+    # Principled BSDF an artist has edited is left alone.
+    inert = [nd for nd in nodes if nd.type == "BSDF_PRINCIPLED" and nd != bsdf and _pristine(nd, tree)]
     if bsdf is None and inert:
         bsdf = inert.pop(0)
         bsdf.name = bsdf.label = NODE

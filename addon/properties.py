@@ -26,15 +26,15 @@ from .live import working_space
 MATERIAL_FIELDS = tuple(spec for spec in schema.PAINT_FIELDS.values() if spec.on_material)
 
 #: The preset menu, each item with its stored number (files keep the number:
-#: Custom 0, the paper's samples 1-3, Spectral 4).
+#: Custom 0, the paper's samples 1-3, Spectral 4; a new sample takes 5 on).
 PRESET_ITEMS = [
     ("CUSTOM", "Custom", "Paint given by the fields below", 0),
     *(
-        (name, name.replace("_", " ").title(), f"The paper's {name.replace('_', ' ')} sample", number)
-        for number, name in enumerate(lut.PRESETS, start=1)
+        (name, name.replace("_", " ").title(), f"The paper's {name.replace('_', ' ')} sample", n if n < 4 else n + 1)
+        for n, name in enumerate(lut.PRESETS, start=1)
     ),
     ("SPECTRAL", "Spectral", "The spectral paint stored from Python (addon.api.set_paint); the fields show its RGB",
-     len(lut.PRESETS) + 1),
+     4),
 ]  # fmt: skip
 #: The menu of a material with no spectral paint stored: Spectral would have nothing to show.
 _PRESET_ITEMS_RGB = PRESET_ITEMS[:-1]

@@ -148,6 +148,12 @@ def test_a_new_material_exports_its_fallback_not_blenders_default(fresh_file, lu
     params, _ = export.fallback_params(material)
     principled_nodes = [nd for nd in material.node_tree.nodes if nd.type == "BSDF_PRINCIPLED"]
     assert [nd.name for nd in principled_nodes] == [export.NODE]
+    # A Principled BSDF an artist set aside (edited, unlinked) is kept.
+    aside = material.node_tree.nodes.new("ShaderNodeBsdfPrincipled")
+    aside.inputs["Base Color"].default_value = (0.1, 0.2, 0.3, 1.0)
+    export.update_fallback(material, api.paint_of(material))
+    assert aside.name in material.node_tree.nodes
+    material.node_tree.nodes.remove(aside)
     mesh = bpy.data.meshes.new("plane")
     mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [(0, 1, 2)])
     mesh.materials.append(material)
