@@ -32,7 +32,6 @@ import importlib
 import json
 import os
 import pathlib
-import re
 import subprocess
 import sys
 import tempfile
@@ -65,7 +64,10 @@ def save_atomically(path: pathlib.Path, pack=False) -> None:
                 image.pack()
     with files.atomic_target(path) as tmp:
         os.remove(tmp)  # let Blender create it: no .blend1 of the placeholder
-        _write_blend(tmp)
+        try:
+            _write_blend(tmp)
+        except RuntimeError as exc:  # Blender's message names the hidden temporary file: name the file
+            raise RuntimeError(str(exc).replace(str(tmp), path.name).strip()) from None
 
 
 def _write_blend(filepath):
@@ -224,8 +226,6 @@ def bake_file(path, force=False, pack=False, **options) -> dict:
             raise ValueError(
                 f"{path} is the add-on's own asset library: never written (append its materials to bake them)"
             )
-        if not path.stat().st_mode & 0o222:  # by its mode bits: root may write anything
-            raise ValueError(f"{path} is read-only: not baked or saved (make it writable to bake it)")
         with _blender_chatter_to_stderr():
             bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
     except (ValueError, RuntimeError) as exc:
@@ -245,11 +245,11 @@ def bake_file(path, force=False, pack=False, **options) -> dict:
     baked = any(m["status"] == "baked" for m in entry["materials"].values())
     if baked or pack:
         try:
+            if not path.stat().st_mode & 0o222:  # by its mode bits: root may write anything
+                raise PermissionError(f"{path.name} is read-only: kept as it is (make it writable to save its bakes)")
             save_atomically(path, pack=pack)
         except (OSError, RuntimeError) as exc:
-            # Blender's message names the hidden temporary file: name the file.
-            message = re.sub(r"\S*\.partial\.blend\S*", path.name, str(exc)).strip()
-            entry.update(status="failed", reason=f"cannot save {path}: {message}")
+            entry.update(status="failed", reason=f"cannot save {path}: {exc}")
             for m in entry["materials"].values():
                 if m["status"] == "baked":  # its bake is not in the file
                     m.update(status="failed", reason="baked, but the file could not be saved")

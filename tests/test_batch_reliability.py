@@ -208,8 +208,7 @@ def test_a_library_of_materials_kept_by_fake_users_is_baked(tmp_path):
     paint_material("orphan paint")  # saved by nobody but this test's save
     library = save(tmp_path / "classic.blend")
     statuses = {n: m["status"] for n, m in batch.bake_file(library)["materials"].items()}
-    assert statuses.get("kept paint") == "baked"
-    assert statuses.get("orphan paint", "unused") == "unused"
+    assert statuses == {"kept paint": "baked"}  # the orphan is not even saved
 
 
 def test_links_into_the_bundled_library_keep_their_fallback_and_it_is_never_written(tmp_path):
@@ -302,16 +301,23 @@ def test_saving_keeps_the_blend_permissions(tmp_path, mode):
 
 
 def test_a_read_only_blend_is_reported_and_never_written(tmp_path):
-    """A 0444 file in a writable folder stays as it is, --force or not."""
+    """A 0444 file in a writable folder stays as it is, --force or not: one
+    that needs a save is reported failed, one whose bakes are current is
+    unchanged (a read-only checkout of a baked shot)."""
     scene = new_file()
     scene.collection.objects.link(triangle("red", paint_material("red")))
     blend = save(tmp_path / "kept.blend")
     blend.chmod(0o444)
     before = blend.read_bytes()
     entry = batch.bake_file(blend, force=True)
-    assert entry["status"] == "failed" and "kept.blend is read-only: not baked or saved" in entry["reason"]
+    assert entry["status"] == "failed" and "kept.blend is read-only: kept as it is" in entry["reason"]
+    red = entry["materials"]["red"]
+    assert (red["status"], red["reason"]) == ("failed", "baked, but the file could not be saved")
     assert blend.read_bytes() == before and stat.S_IMODE(blend.stat().st_mode) == 0o444
-    assert not (tmp_path / "paint_lut").exists()
+    blend.chmod(0o644)
+    assert batch.bake_file(blend)["status"] == "saved"
+    blend.chmod(0o444)
+    assert batch.bake_file(blend)["status"] == "unchanged"
 
 
 def test_a_file_that_cannot_be_saved_lists_no_material_baked(tmp_path, monkeypatch):
@@ -324,6 +330,9 @@ def test_a_file_that_cannot_be_saved_lists_no_material_baked(tmp_path, monkeypat
 
     def refuse(filepath):
         raise RuntimeError(f"Error: Cannot open file {filepath} for writing: No space left on device")
+
+    (tmp_path / "a folder").mkdir()  # a space in the path: still named in full
+    blend = save(tmp_path / "a folder" / "shot.blend")
 
     monkeypatch.setattr(batch, "_write_blend", refuse)
     entry = batch.bake_file(blend)
