@@ -35,12 +35,13 @@ import pathlib
 import subprocess
 import sys
 import tempfile
+import tomllib
 
 import bpy
 
 from . import api, nodes
 from ._lut import closures, files, fitting, lut
-from .library import ASSETS
+from .library import ASSETS, LIBRARY_BLEND
 
 #: The first bytes of a .blend file: plain, gzip (Blender < 3) or zstd compressed.
 _MAGIC = (b"BLENDER", b"\x1f\x8b", b"\x28\xb5\x2f\xfd")
@@ -111,11 +112,25 @@ def _blender_chatter_to_stderr():
 
 
 def bundled(path) -> bool:
-    """Whether ``path`` is in the add-on's own asset library folder: a file
-    the batch links from but never writes (it ships with the extension, saved
-    by the oldest Blender the extension supports)."""
+    """Whether ``path`` is the add-on's own asset library, of this install
+    or of another Blender version's (an ``assets`` folder holding that file
+    beside this extension's manifest): a file the batch links from but never
+    writes (it ships with the extension, saved by the oldest Blender the
+    extension supports)."""
     path = pathlib.Path(os.path.realpath(path))
-    return path.parent == pathlib.Path(os.path.realpath(ASSETS))
+    if path.parent == pathlib.Path(os.path.realpath(ASSETS)):
+        return True
+    if path.name != LIBRARY_BLEND.name or path.parent.name != ASSETS.name:
+        return False
+    manifest = path.parent.parent / "blender_manifest.toml"
+    try:
+        return tomllib.loads(manifest.read_text()).get("id") == EXTENSION_ID
+    except (OSError, ValueError):
+        return False
+
+
+#: The extension's id (blender_manifest.toml): what marks another install's bundled library.
+EXTENSION_ID = "paint_lut"
 
 
 def _report_name(material) -> str:

@@ -169,13 +169,23 @@ def untracked(root: pathlib.Path = ROOT) -> list[str]:
     """Files the zip would pack (lut/, addon/) that git does not track: a
     build packs what the repository holds, not what lies in a working copy.
     Empty outside a git checkout (a source archive holds only tracked files)."""
-    done = subprocess.run(
-        ["git", "ls-files", "--others", "--exclude-standard", "--", "lut", "addon"],
-        cwd=root, capture_output=True, text=True,
-    )  # fmt: skip
+    try:
+        done = subprocess.run(
+            ["git", "ls-files", "--others", "--exclude-standard", "--", "lut", "addon"],
+            cwd=root, capture_output=True, text=True,
+        )  # fmt: skip
+    except OSError:  # no git
+        return []
     if done.returncode != 0:
         return []
-    return [name for name in done.stdout.splitlines() if name.endswith((".py", ".blend", ".txt", ".toml"))]
+    packed = {f"addon/assets/{name}" for name in ASSETS}
+    return [
+        name
+        for name in done.stdout.splitlines()
+        if (name.startswith("lut/") and name.endswith(".py"))
+        or (name.startswith("addon/") and name.count("/") == 1 and name.endswith(".py"))
+        or name in packed
+    ]
 
 
 def build(output_dir, blender: str | None = None) -> pathlib.Path:

@@ -233,6 +233,16 @@ def test_links_into_the_bundled_library_keep_their_fallback_and_it_is_never_writ
     assert entry["status"] == "failed" and "the add-on's own asset library: never written" in entry["reason"]
     assert library.LIBRARY_BLEND.stat().st_mtime_ns == before and sorted(library.ASSETS.iterdir()) == listing
 
+    # Another Blender version's install of the extension: known by its manifest.
+    root = pathlib.Path(addon.__file__).resolve().parents[1]
+    other = tmp_path / "4.2" / "extensions" / "user_default" / "paint_lut"
+    (other / "assets").mkdir(parents=True)
+    (other / "blender_manifest.toml").write_text((root / "blender_manifest.toml").read_text())
+    (other / "assets" / library.LIBRARY_BLEND.name).write_bytes(library.LIBRARY_BLEND.read_bytes())
+    assert batch.bundled(other / "assets" / library.LIBRARY_BLEND.name)
+    (other / "blender_manifest.toml").write_text('id = "someone_else"\n')
+    assert not batch.bundled(other / "assets" / library.LIBRARY_BLEND.name)
+
 
 # ----------------------------------------------------------------------------- one bad material fails alone
 

@@ -412,3 +412,14 @@ def test_a_folder_that_refuses_writes_is_named_not_the_hidden_file(tmp_path, mon
     with pytest.raises(PermissionError, match=r"cannot write a\.exr into .*: Permission denied") as error:
         files.atomic_write_bytes(tmp_path / "a.exr", b"x")
     assert ".partial" not in str(error.value)
+
+
+def test_files_read_where_python_has_no_stderr(tmp_path, monkeypatch):
+    """An embedded interpreter (or pythonw) may have no sys.stderr: reading
+    a LUT still works, and a damaged one still raises its LUTError."""
+    path = lut.bake(lut.Paint(rho=0.5), tmp_path, resolution=(8, 6, 4))
+    monkeypatch.setattr(sys, "stderr", None)
+    assert lut.load_lut(path).key
+    path.write_bytes(path.read_bytes()[: path.stat().st_size // 2])
+    with pytest.raises(lut.LUTError):
+        lut.load_lut(path)

@@ -129,7 +129,7 @@ def _read_any(path, keys, prefix):
             inp.close()
     if pixels is None or np.ndim(pixels) != 3 or error:
         raise LUTError(f"{path}: pixel data cannot be read (truncated file?): {error or oiio.geterror()}")
-    if printed:  # a file that reads whole: what the libraries printed is news, pass it on
+    if printed and sys.stderr is not None:  # a file that reads whole: what the libraries printed is news
         sys.stderr.write(printed[0])
     return np.asarray(pixels, dtype=np.float32), attrs
 
@@ -145,12 +145,19 @@ def _stderr_kept():
     held = []
     with _STDERR_LOCK:  # one redirection at a time: threads read files too
         try:
-            sys.stderr.flush()
-            saved = os.dup(2)
+            if sys.stderr is not None:
+                sys.stderr.flush()
+            sink_file = tempfile.TemporaryFile()
         except (OSError, ValueError):
+            yield held  # nothing to flush into, or no temporary file: not held
+            return
+        try:
+            saved = os.dup(2)
+        except OSError:
+            sink_file.close()
             yield held
             return
-        with _held_into(saved) as sink:
+        with _held_into(saved, sink_file) as sink:
             yield held
         if sink:
             held.append(sink[0])
@@ -160,11 +167,11 @@ _STDERR_LOCK = threading.RLock()
 
 
 @contextlib.contextmanager
-def _held_into(saved):
-    """Descriptor 2 into a temporary file for the block, then back to
-    ``saved`` (closed after); yields a list that gets the file's text."""
+def _held_into(saved, sink_file):
+    """Descriptor 2 into ``sink_file`` for the block, then back to ``saved``
+    (both closed after); yields a list that gets the file's text."""
     text = []
-    with tempfile.TemporaryFile() as sink:
+    with sink_file as sink:
         os.dup2(sink.fileno(), 2)
         try:
             yield text
