@@ -15,7 +15,8 @@ Header attributes:
   paintlut:format  the format version (int)
   paintlut:meta    JSON: paint, working space, parameterization, resolution,
                    quadrature sizes, model version
-  paintlut:key     SHA-256 of the canonical meta JSON: the cache key
+  paintlut:key     SHA-256 of the canonical meta JSON without its derived
+                   fields (``DERIVED_FIELDS``: r̄): the cache key
   paintlut:hash    SHA-256 of the meta JSON and the pixel bytes: detects a
                    file whose content was altered
 
