@@ -23,20 +23,22 @@ pytestmark = pytest.mark.usefixtures("addon_registered")
 
 
 def make_blend(path, used=("red", "blue"), unused=("spare",)):
-    """A scene with one cube per used paint material and a paint material on no object."""
+    """A scene with one cube per used paint material and a paint material
+    on a mesh no object shows (a material kept by a fake user alone is a
+    library's, and bakes)."""
     bpy.ops.wm.read_factory_settings(use_empty=True)
     scene = bpy.context.scene
     for i, name in enumerate((*used, *unused)):
         material = bpy.data.materials.new(name)
         material.paint_lut.enabled = True
         material.paint_lut.rho = (0.1 + 0.2 * i, 0.3, 0.5)
+        mesh = bpy.data.meshes.new(name)
+        mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [(0, 1, 2)])
+        mesh.materials.append(material)
         if name in used:
-            mesh = bpy.data.meshes.new(name)
-            mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [(0, 1, 2)])
-            mesh.materials.append(material)
             scene.collection.objects.link(bpy.data.objects.new(name, mesh))
         else:
-            material.use_fake_user = True  # kept in the file, on no object
+            mesh.use_fake_user = True  # kept in the file, shown by no object
     bpy.ops.wm.save_as_mainfile(filepath=str(path))
     return path
 
