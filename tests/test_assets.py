@@ -193,7 +193,7 @@ def test_a_failed_first_bake_is_recorded_not_raised(fresh_file, lut_dir):
     material.paint_lut.preset = "SPECTRAL"  # a stored spectral paint that is not valid: cannot be baked
     status = library.bake_pending(directory=lut_dir)
     assert status["Glossy White"].startswith("failed: ")
-    assert library.FIRST_USE not in material and "unknown spectrum" in material[library.ERROR]
+    assert library.FIRST_USE not in material and "spectrum 'no such spectrum'" in material[library.ERROR]
     assert library.pending() == []
 
 
