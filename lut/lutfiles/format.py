@@ -148,41 +148,29 @@ def _stderr_kept():
         try:
             if sys.stderr is not None:
                 sys.stderr.flush()
-            sink_file = tempfile.TemporaryFile()
+            sink = tempfile.TemporaryFile()
         except (OSError, ValueError):
             yield held  # nothing to flush into, or no temporary file: not held
             return
-        try:
-            saved = os.dup(2)
-        except OSError:
-            sink_file.close()
-            yield held
-            return
-        with _held_into(saved, sink_file) as sink:
-            yield held
-        if sink:
-            held.append(sink[0])
-
-
-_STDERR_LOCK = threading.RLock()
-
-
-@contextlib.contextmanager
-def _held_into(saved, sink_file):
-    """Descriptor 2 into ``sink_file`` for the block, then back to ``saved``
-    (both closed after); yields a list that gets the file's text."""
-    text = []
-    with sink_file as sink:
-        os.dup2(sink.fileno(), 2)
-        try:
-            yield text
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
+        with sink:
+            try:
+                saved = os.dup(2)
+            except OSError:
+                yield held
+                return
+            os.dup2(sink.fileno(), 2)
+            try:
+                yield held
+            finally:
+                os.dup2(saved, 2)
+                os.close(saved)
             sink.seek(0)
             printed = sink.read().decode(errors="replace")
             if printed:
-                text.append(printed)
+                held.append(printed)
+
+
+_STDERR_LOCK = threading.RLock()
 
 
 def _attribute(spec, key, path):
@@ -207,8 +195,13 @@ DERIVED_FIELDS = ("internal_reflectance",)
 def cache_key(meta: dict) -> str:
     """The key of a bake's ``meta``: a hash of what determines its content
     (everything but ``DERIVED_FIELDS``)."""
-    kept = {name: value for name, value in meta.items() if name not in DERIVED_FIELDS}
-    return hashlib.sha256(canonical_json(kept).encode()).hexdigest()
+    return _meta_hash({name: value for name, value in meta.items() if name not in DERIVED_FIELDS})
+
+
+def _meta_hash(meta: dict) -> str:
+    """SHA-256 of a meta's canonical JSON (the key of files written before
+    ``DERIVED_FIELDS`` were left out of keys: the whole meta)."""
+    return hashlib.sha256(canonical_json(meta).encode()).hexdigest()
 
 
 def content_hash(meta_json: str, pixels: np.ndarray) -> str:
@@ -320,7 +313,7 @@ def read(path):
     # A file written before DERIVED_FIELDS were left out of keys has the
     # key of its whole meta: still whole, and read (a bake names its new
     # files by the new key, so such a file is baked again once, not lost).
-    if header["key"] not in (cache_key(meta), hashlib.sha256(canonical_json(meta).encode()).hexdigest()):
+    if header["key"] not in (cache_key(meta), _meta_hash(meta)):
         raise LUTError(f"{path}: header key does not match its meta (altered file)")
     if header["hash"] != content_hash(header["meta_json"], pixels):
         raise LUTError(f"{path}: content does not match its hash (altered or damaged file)")
