@@ -34,6 +34,7 @@ def _module(path: str):
 
 
 schema = _module("paint.schema")
+cleanup = _module("lutfiles.cleanup")
 exr = _module("lutfiles.exr")
 files = _module("lutfiles.files")
 lutfile = _module("lutfiles.format")

@@ -20,16 +20,16 @@ import bpy
 from bpy.app.handlers import persistent
 
 from . import api
-from ._lut import files
+from ._lut import cleanup, files
 
 #: The paths changed by the save under way: [(ID, attribute, old value)].
 _CHANGED: list = []
 
 
 def _bake_files(lut_path: pathlib.Path) -> list[pathlib.Path]:
-    """A LUT and the weights files fitted to it (named by its key)."""
-    key = lut_path.name.removeprefix("paintlut-")
-    return [lut_path, *sorted(lut_path.parent.glob(f"paintfit-*-{key}"))]
+    """A LUT and the weights files fitted to it (their names hold its key)."""
+    key = cleanup.file_key(lut_path)
+    return sorted(path for path in lut_path.parent.iterdir() if path.is_file() and cleanup.file_key(path) == key)
 
 
 def take_bakes_along(blend_path) -> list:

@@ -16,7 +16,6 @@ import json
 import math
 import os
 import pathlib
-import re
 import sys
 import time
 import tomllib
@@ -224,7 +223,7 @@ def _cmd_info(args) -> int:
         if i:
             print()
         _print_info(file, header)
-        named = _named_key(file)
+        named = cleanup.file_key(file)
         if named is not None and not header["key"].startswith(named):
             print(
                 f"error: {file}: its name says key {named} but it holds the LUT of key {header['key'][:24]} "
@@ -233,13 +232,6 @@ def _cmd_info(args) -> int:
             )
             status = 2
     return status
-
-
-def _named_key(file):
-    """The key prefix a LUT file's name gives (``paintlut-<key>.exr``), or
-    None for a name of another form."""
-    match = re.fullmatch(r"paintlut-([0-9a-f]{24})\.exr", pathlib.Path(file).name)
-    return match.group(1) if match else None
 
 
 def _print_info(file, header) -> None:

@@ -17,7 +17,9 @@ _LUT = re.compile(r"^paintlut-(?P<key>[0-9a-f]{8,64})\.exr$")
 _WEIGHTS = re.compile(r"^paintfit-(?:[a-z0-9]+-)*(?P<key>[0-9a-f]{8,64})\.exr$")
 
 
-def _key(path) -> str | None:
+def file_key(path) -> str | None:
+    """The key a LUT or weights file's name gives (``paintlut-<key>.exr``,
+    ``paintfit-...-<key>.exr``), or None for a name of another form."""
     name = pathlib.Path(path).name
     match = _LUT.match(name) or _WEIGHTS.match(name)
     return match["key"] if match else None
@@ -34,12 +36,14 @@ def unused_files(directory, keep) -> list[pathlib.Path]:
         raise ValueError("keep must be a list of file paths, not one path")
     kept = set()
     for path in keep:
-        key = _key(path)
+        key = file_key(path)
         if key is None:
             raise ValueError(f"keep: {str(path)!r} is not a LUT (paintlut-<key>.exr) or weights (paintfit-...) file")
         kept.add(key)
     return sorted(
-        path for path in directory.iterdir() if path.is_file() and _key(path) is not None and _key(path) not in kept
+        path
+        for path in directory.iterdir()
+        if path.is_file() and file_key(path) is not None and file_key(path) not in kept
     )
 
 
