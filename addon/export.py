@@ -47,16 +47,19 @@ def _values(node) -> list:
     ]
 
 
-def _pristine(node, tree) -> bool:
-    """A Principled BSDF as Blender makes it: no link in or out and every
-    input at the new node's default."""
-    if _linked(node):
-        return False
+def _pristine_principled(tree, fallback) -> list:
+    """The tree's Principled BSDFs but ``fallback`` as Blender makes them: no
+    link in or out and every input at a new node's default (the new node to
+    compare with is made once, and only where there is a node to compare)."""
+    others = [nd for nd in tree.nodes if nd.type == "BSDF_PRINCIPLED" and nd != fallback and not _linked(nd)]
+    if not others:
+        return []
     reference = tree.nodes.new("ShaderNodeBsdfPrincipled")
     try:
-        return node.distribution == reference.distribution and _values(node) == _values(reference)
+        default = (reference.distribution, _values(reference))
     finally:
         tree.nodes.remove(reference)
+    return [nd for nd in others if (nd.distribution, _values(nd)) == default]
 
 
 def add_principled_fallback(material, params: principled.PrincipledParams, error: float | None = None):
@@ -78,7 +81,7 @@ def add_principled_fallback(material, params: principled.PrincipledParams, error
     # its default) is taken over as the fallback when there is none yet, and
     # removed when there is, so that the exporter finds the fallback.  A
     # Principled BSDF an artist has edited is left alone.
-    inert = [nd for nd in nodes if nd.type == "BSDF_PRINCIPLED" and nd != bsdf and _pristine(nd, tree)]
+    inert = _pristine_principled(tree, bsdf)
     if bsdf is None and inert:
         bsdf = inert.pop(0)
         bsdf.name = bsdf.label = NODE
