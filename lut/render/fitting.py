@@ -445,7 +445,7 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None, star
         if idx:
             errors[p] = _nnls_fit(gram, rhs[:, p], norm[:, p], idx, upper[idx])[1]
     spent = int(sum(cost[k] for k in chosen))
-    shared = None if spent + cost.max() <= budget else len(chosen)
+    shared = None
     while targets:
         if max(errors.values()) < goal:
             break
