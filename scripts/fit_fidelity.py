@@ -6,6 +6,12 @@ grazing band (θl >= 60°), each against its goal (``measure.goals``).
 
     .venv/bin/python scripts/fit_fidelity.py [--set dark|random] [--count 24] [--seed N]
     .venv/bin/python scripts/fit_fidelity.py --limits
+    .venv/bin/python scripts/fit_fidelity.py --set random --budgets 3 5 8
+
+``--budgets``: the Cycles fit's error against its closure budget (render
+cost grows with each closure: ``scripts/render_cost.py --per-kind``), each
+budget without extra closures, beside the default (``BUDGET`` and
+``EXTRA_BUDGET`` where a goal is missed).
 
 ``--set random`` is the randomised set of ``lut.bench.random_paints``;
 ``--set dark`` the dark, facet-dominated rough paints of
@@ -58,6 +64,23 @@ def limits(directory, budgets=(8, 12, 40)):
     return rows
 
 
+def budget_tradeoff(paints, directory, budgets):
+    """{budget label: [(paint, (whole, grazing) error, closures counted)]}
+    of the Cycles fit of each paint within each budget (no extra closures),
+    and of the default fit ("default")."""
+    from lut.lutfiles import baking
+
+    rows = {f"{b}": [] for b in budgets} | {"default": []}
+    for _, paint in paints:
+        table = baking.load_lut(baking.bake(paint, directory))
+        amps = table.amplitudes(paint)
+        for label, kwargs in [(f"{b}", {"budget": b, "extra_budget": 0}) for b in budgets] + [("default", {})]:
+            fitted = fitting.fit_lut(table, "CYCLES", **kwargs)
+            counted = sum(c.cost for c in fitted.closures)
+            rows[label].append((paint, (fitted.error(amps), fitted.grazing_error(amps)), counted))
+    return rows
+
+
 def fidelity(paints, directory):
     """[(label, paint, {"CYCLES", "CYCLES 4.x", "EEVEE": reported (whole,
     grazing band) error})]."""
@@ -84,7 +107,35 @@ def main(argv=None) -> int:
     parser.add_argument(
         "--limits", action="store_true", help="instead: black-pigment facet terms fitted with 8, 12 and 40 closures"
     )
+    parser.add_argument(
+        "--budgets", type=int, nargs="+", help="instead: the Cycles fit within each of these closure budgets"
+    )
     args = parser.parse_args(argv)
+    if args.budgets:
+        kwargs = {} if args.seed is None else {"seed": args.seed}
+        with tempfile.TemporaryDirectory() as tmp:
+            tradeoff = budget_tradeoff(SETS[args.set](args.count, **kwargs), pathlib.Path(tmp), args.budgets)
+        print(
+            "| budget | kind | closures (median, most) | worst whole / grazing"
+            " | median whole / grazing | within goals |"
+        )
+        print("|---|---|---|---|---|---|")
+        for label, rows in tradeoff.items():
+            for name, rough in (("smooth", False), ("rough", True)):
+                chosen = [(e, n) for p, e, n in rows if (p.slope > 0) == rough]
+                if not chosen:
+                    continue
+                errors = np.array([e for e, _ in chosen])
+                counts = [n for _, n in chosen]
+                goals = measure.goals("CYCLES", not rough)
+                within = sum(e[0] <= goals[0] and e[1] <= goals[1] for e in errors)
+                print(
+                    f"| {label} | {name} | {np.median(counts):g}, {max(counts)} "
+                    f"| {errors[:, 0].max():.2%} / {errors[:, 1].max():.2%} "
+                    f"| {np.median(errors[:, 0]):.2%} / {np.median(errors[:, 1]):.2%} "
+                    f"| {within} of {len(errors)} |"
+                )
+        return 0
     if args.limits:
         with tempfile.TemporaryDirectory() as tmp:
             for distribution, slope, errors in limits(pathlib.Path(tmp)):
