@@ -42,6 +42,34 @@ def test_batched_nnls_reaches_scipys_optimum_on_near_collinear_problems():
     assert np.all(capped <= 1.0) and np.all(capped >= 0)
 
 
+def test_warm_started_nnls_reaches_the_same_optimum():
+    """A warm start (forward selection's previous weights, padded with the
+    new closure at zero; or any positive guess, wrong support included)
+    reaches the optimum of the cold start: the KKT conditions hold (x >= 0,
+    no gradient on the positive weights, none pointing into the zero ones)."""
+    rng = np.random.default_rng(5)
+    a = rng.random((40, 7))
+    a[:, 6] = 0.995 * a[:, 5] + 0.005 * rng.random(40)  # near collinear, as Toon ramps are
+    b = rng.random((30, 40)) - 0.35
+    gram = np.repeat((a.T @ a)[None], 30, axis=0)
+    rhs = b @ a
+    cold = nnls_gram_batch(gram, rhs)
+    fewer = nnls_gram_batch(gram[:, :6, :6], rhs[:, :6])
+    starts = {
+        "selection": np.pad(fewer, ((0, 0), (0, 1))),
+        "guess": rng.random((30, 7)),
+        "wrong support": np.where(cold > 0, 0.0, 1.0),
+    }
+    for name, start in starts.items():
+        x = nnls_gram_batch(gram, rhs, start=start)
+        w = rhs - np.einsum("bij,bj->bi", gram, x)
+        assert np.all(x >= 0), name
+        assert np.abs(w[x > 0]).max() < 1e-8, name
+        assert w[x == 0].max(initial=-1.0) < 1e-8, name
+        np.testing.assert_allclose(x, cold, atol=1e-7, err_msg=name)
+    assert (cold == 0).any() and (cold > 0).any()  # both kinds of constraint are met above
+
+
 def test_toon_closures_integrate_to_their_cone():
     """A Toon closure with no smoothing is a uniform cone: its hemispherical
     integral of the contribution (cos included) over directions is 1."""

@@ -411,8 +411,10 @@ def view_measure(theta_v):
     return width * np.where(np.asarray(theta_v) <= SELECTION_VIEW, 1.0, 0.1)
 
 
-def _nnls_fit(gram, rhs, norm, idx, upper):
-    """Per-view NNLS weights on closures ``idx``: (x (M, s), relative squared error)."""
+def _nnls_fit(gram, rhs, norm, idx, upper, start=None):
+    """Per-view NNLS weights on closures ``idx``: (x (M, s), relative squared
+    error).  ``start`` (M, s): a warm start (``nnls.nnls_gram_batch``), the
+    weights of the same closures but the last."""
     idx = list(idx)
     sub = gram[:, idx][:, :, idx]  # (M, s, s)
     g = rhs[:, idx]
@@ -422,7 +424,7 @@ def _nnls_fit(gram, rhs, norm, idx, upper):
     x = solve_spd(sub + 1e-13 * scale[:, None, None] * np.eye(len(idx)), g)
     bad = (np.any(x < 0, axis=1) | np.any(x > upper, axis=1)) & (norm[:, 0] > 0)
     if bad.any():
-        x[bad] = nnls_gram_batch(sub[bad], g[bad], upper=upper)
+        x[bad] = nnls_gram_batch(sub[bad], g[bad], upper=upper, start=None if start is None else start[bad])
     x[norm[:, 0] == 0] = 0.0
     err = norm[:, 0] - 2 * np.sum(x * g, axis=1) + np.einsum("ms,mst,mt->m", x, sub, x)
     return x, float(_relative(np.maximum(err, 0.0), norm))
@@ -440,10 +442,11 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None, star
     targets = [p for p in range(rhs.shape[1]) if norm[:, p, 0].sum() > 0]
     chosen: list[int] = list(start)
     errors = {p: 1.0 for p in targets}
+    solutions = {p: np.zeros((gram.shape[0], 0)) for p in targets}  # each target's weights on its chosen closures
     for p in targets:
         idx = [k for k in chosen if allowed[p, k]]
         if idx:
-            errors[p] = _nnls_fit(gram, rhs[:, p], norm[:, p], idx, upper[idx])[1]
+            solutions[p], errors[p] = _nnls_fit(gram, rhs[:, p], norm[:, p], idx, upper[idx])
     spent = int(sum(cost[k] for k in chosen))
     shared = None
     while targets:
@@ -473,25 +476,26 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None, star
                 new = _ls_errors(gram, rhs[:, p], norm[:, p], base, [cands[i] for i in ok])
                 proxy[ok] += np.minimum(new, errors[p]) - errors[p]
         current = sum(errors.values())
-        best, best_gain, best_errors = None, 0.0, None
+        best, best_gain, best_errors, best_solutions = None, 0.0, None, None
         order = np.argsort((proxy - current) / cost[cands])
         for rank, i in enumerate(order):
             if rank >= _CANDIDATES_CHECKED and best is not None:
                 break  # the proxy's best few were checked and one helps
             k = cands[i]
-            trial = dict(errors)
+            trial, trial_solutions = dict(errors), dict(solutions)
             for p in targets:
                 if allowed[p, k]:
                     idx = [j for j in chosen + [k] if allowed[p, j]]
-                    trial[p] = _nnls_fit(gram, rhs[:, p], norm[:, p], idx, upper[idx])[1]
+                    start = np.pad(solutions[p], ((0, 0), (0, 1)))  # k enters last, at zero
+                    trial_solutions[p], trial[p] = _nnls_fit(gram, rhs[:, p], norm[:, p], idx, upper[idx], start)
             gain = (current - sum(trial.values())) / cost[k]  # error reduction per unit of render cost
             if gain > max(best_gain, 1e-9):
-                best, best_gain, best_errors = k, gain, trial
+                best, best_gain, best_errors, best_solutions = k, gain, trial, trial_solutions
         if best is None:
             break
         chosen.append(best)
         spent += cost[best]
-        errors = best_errors
+        errors, solutions = best_errors, best_solutions
     return chosen, len(chosen) if shared is None else shared
 
 

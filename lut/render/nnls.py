@@ -87,7 +87,7 @@ def nnls_gram(gram, rhs, tol=None, max_iter=None, upper=None):
     return x
 
 
-def nnls_gram_batch(gram, rhs, upper=None, max_iter=None):
+def nnls_gram_batch(gram, rhs, upper=None, max_iter=None, start=None):
     """``nnls_gram`` for a batch of independent problems at once: gram
     (B, n, n), rhs (B, n) -> x (B, n).  The same active-set iteration, every
     problem stepping together with its own passive set (a masked system:
@@ -95,11 +95,14 @@ def nnls_gram_batch(gram, rhs, upper=None, max_iter=None):
     side), so the cost is a few batched solves rather than B Python loops.
     ``upper`` (n,): variables above it are fixed at it and the rest solved
     again, until none is above (the bound-constrained optimum when the
-    bound binds on few variables, as for Mix Shader factors)."""
+    bound binds on few variables, as for Mix Shader factors).  ``start``
+    (B, n): a guess whose positive entries form the first passive sets (a
+    warm start: the solution of a problem with one variable fewer, as in
+    forward selection, takes one or two steps instead of one per variable)."""
     gram, rhs = np.asarray(gram, dtype=float), np.asarray(rhs, dtype=float)
     b, n = rhs.shape
     fixed = np.zeros((b, n), dtype=bool)
-    x = _batch_active_set(gram, rhs, fixed, max_iter)
+    x = _batch_active_set(gram, rhs, fixed, max_iter, start)
     if upper is None:
         return x
     upper = np.broadcast_to(np.asarray(upper, dtype=float), (n,))
@@ -115,7 +118,7 @@ def nnls_gram_batch(gram, rhs, upper=None, max_iter=None):
     return x
 
 
-def _batch_active_set(gram, rhs, excluded, max_iter=None):
+def _batch_active_set(gram, rhs, excluded, max_iter=None, start=None):
     b, n = rhs.shape
     scale = np.maximum(np.abs(gram).reshape(b, -1).max(axis=1), 1e-300)
     tol = 1e-12 * scale * max(n, 1)
@@ -135,15 +138,13 @@ def _batch_active_set(gram, rhs, excluded, max_iter=None):
     x = np.zeros((b, n))
     passive = np.zeros((b, n), dtype=bool)
     active = np.ones(b, dtype=bool)
-    for _ in range(max_iter):
-        w = rhs - np.einsum("bij,bj->bi", gram, x)
-        candidates = np.where(passive | excluded, -np.inf, w)
-        j = np.argmax(candidates, axis=1)
-        active &= candidates[np.arange(b), j] > tol
-        if not active.any():
-            break
-        passive[np.flatnonzero(active), j[active]] = True
-        pending = active.copy()  # the problems whose passive set is not yet feasible
+
+    def settle(pending, retire=True):
+        """Lawson and Hanson's inner loop: solve on the passive sets of the
+        ``pending`` problems, stepping back toward feasibility (dropping the
+        variables that reach zero) until each solution is positive;
+        ``retire``: a problem left with no passive variable is done."""
+        nonlocal x, passive
         for _inner in range(3 * n + 3):
             z = solve(passive, np.flatnonzero(pending))
             neg = passive & (z <= 0)
@@ -157,6 +158,24 @@ def _batch_active_set(gram, rhs, excluded, max_iter=None):
             x = np.where(bad[:, None], x + alpha * (z - x), x)
             passive &= ~(bad[:, None] & (x <= tol[:, None] / scale[:, None]))
             x = np.where(passive, x, 0.0)
-            active &= passive.any(axis=1) | ~bad
-            pending = bad & active
+            if retire:
+                active[:] &= passive.any(axis=1) | ~bad
+            pending = bad & active & passive.any(axis=1)
+
+    if start is not None:
+        # A feasible start (x >= 0, zero outside its passive set) made the
+        # least squares solution of its passive set before the outer loop.
+        passive = (np.asarray(start, dtype=float) > 0) & ~excluded
+        x = np.where(passive, np.asarray(start, dtype=float), 0.0)
+        if passive.any():
+            settle(passive.any(axis=1), retire=False)
+    for _ in range(max_iter):
+        w = rhs - np.einsum("bij,bj->bi", gram, x)
+        candidates = np.where(passive | excluded, -np.inf, w)
+        j = np.argmax(candidates, axis=1)
+        active &= candidates[np.arange(b), j] > tol
+        if not active.any():
+            break
+        passive[np.flatnonzero(active), j[active]] = True
+        settle(active.copy())  # the problems whose passive set is not yet feasible
     return x
