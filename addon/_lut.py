@@ -34,6 +34,7 @@ def _module(path: str):
 
 
 schema = _module("paint.schema")
+baking = _module("lutfiles.baking")
 cleanup = _module("lutfiles.cleanup")
 exr = _module("lutfiles.exr")
 files = _module("lutfiles.files")
@@ -44,3 +45,4 @@ fitting = _module("render.fitting")
 measure = _module("render.measure")
 principled = _module("render.principled")
 render_bake = _module("render.bake")
+farm = _module("farm")

@@ -334,7 +334,9 @@ def is_current(material, paint, *, directory=None, exact_metallic=None, **option
         return False
     exact = nodes.exact_metallic_default(exact_metallic)
     path = lut.lut_path(paint, directory or lut_directory(), **options)
-    if pathlib.Path(bpy.path.abspath(settings.lut_path)) != path:
+    # Resolved both ways: a store outside the file's folder is referenced as
+    # //../store/..., which names the same file as the store's own path.
+    if pathlib.Path(bpy.path.abspath(settings.lut_path)).resolve() != path.resolve():
         return False
     try:
         table = lut.load_lut(path)

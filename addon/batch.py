@@ -40,7 +40,7 @@ import tomllib
 import bpy
 
 from . import api, nodes
-from ._lut import closures, files, fitting, lut
+from ._lut import baking, closures, farm, files, fitting, lut
 from .library import ASSETS, LIBRARY_BLEND
 
 #: The first bytes of a .blend file: plain, gzip (Blender < 3) or zstd compressed.
@@ -228,13 +228,9 @@ def shared_bakes(materials: dict) -> dict:
     return {key: names for key, names in groups.items() if len(names) > 1}
 
 
-def bake_file(path, force=False, pack=False, **options) -> dict:
-    """Bake one .blend file.  Returns its report entry: {"file", "status"
-    ("saved", "unchanged" or "failed"), "reason" (when failed), "materials":
-    {name: {"status": "baked" | "cached" | "unused" | "linked" | "failed",
-    "reason", and for linked ones "library" and "baked"}}}.  Never raises."""
-    path = pathlib.Path(path).resolve()
-    entry = {"file": str(path), "materials": {}}
+def _open(path, entry):
+    """Open a .blend for the batch and return the materials it must bake,
+    or None with the entry failed and its reason."""
     try:
         check_blend(path)
         if bundled(path):
@@ -245,11 +241,64 @@ def bake_file(path, force=False, pack=False, **options) -> dict:
             bpy.ops.wm.open_mainfile(filepath=str(path), load_ui=False)
     except (ValueError, RuntimeError) as exc:
         entry.update(status="failed", reason=str(exc).strip())
-        return entry
+        return None
     try:
-        used = materials_to_bake(bpy.data.scenes)
+        return materials_to_bake(bpy.data.scenes)
     except Exception as exc:  # the file cannot be evaluated: nothing is baked or saved
         entry.update(status="failed", reason=f"cannot find the materials it uses: {type(exc).__name__}: {exc}")
+        return None
+
+
+def scan_file(path, store=None) -> dict:
+    """The paint types a .blend file's used materials need (the farm's
+    first phase, ``lut.farm``): its report entry {"file", "status":
+    "scanned" (or "failed" with its "reason"), "paint_types": [{"key", "store",
+    "paint", "exact_metallic", "eevee_calibration", "materials"}]}, one per
+    type and folder, a type's paint being its first material's.  A material
+    whose paint is invalid is left to the bake, which reports it."""
+    path = pathlib.Path(path).resolve()
+    entry = {"file": str(path), "materials": {}}
+    used = _open(path, entry)
+    if used is None:
+        return entry
+    directory = pathlib.Path(store) if store else api.lut_directory()
+    calibration = api.eevee_calibration()
+    types = {}
+    for material in bpy.data.materials:
+        if not material.paint_lut.enabled or material.library is not None or material not in used:
+            continue
+        try:
+            paint = api.paint_of(material)
+        except ValueError:
+            continue
+        key = baking.lut_path(paint, directory).stem.removeprefix("paintlut-")
+        spec = types.setdefault(
+            key,
+            {
+                "key": key,
+                "store": str(directory.resolve()),
+                "paint": paint.to_dict(),
+                "exact_metallic": nodes.exact_metallic_default(None),
+                "eevee_calibration": list(calibration) if calibration else None,
+                "materials": [],
+            },
+        )
+        spec["materials"].append(_report_name(material))
+    entry.update(status="scanned", paint_types=list(types.values()))
+    return entry
+
+
+def bake_file(path, force=False, pack=False, **options) -> dict:
+    """Bake one .blend file.  Returns its report entry: {"file", "status"
+    ("saved", "unchanged" or "failed"), "reason" (when failed), "materials":
+    {name: {"status": "baked" | "cached" | "unused" | "linked" | "failed",
+    "reason", and for linked ones "library" and "baked"}}}.  ``options``:
+    ``api.bake_material``'s (``directory``: where the bakes go, default the
+    file's ``//paint_lut``).  Never raises."""
+    path = pathlib.Path(path).resolve()
+    entry = {"file": str(path), "materials": {}}
+    used = _open(path, entry)
+    if used is None:
         return entry
     for material in list(bpy.data.materials):
         if material.paint_lut.enabled:
@@ -330,6 +379,16 @@ def summary(entries) -> str:
                 lines.append(f"  {name}: fit misses its target: {', '.join(m['fit_misses'])}")
         for key, names in entry.get("shared", {}).items():
             lines.append(f"  one bake of paint type {key[:12]} shared by {', '.join(names)}")
+    types = {key: t for entry in entries for key, t in entry.get("types", {}).items()}  # a farm run's bakes
+    for key, t in types.items():
+        if "failed" in t:
+            lines.append(f"paint type {key[:12]}: its bake failed on the cluster ({t['failed']})")
+        elif t["computed"]:
+            lines.append(
+                f"paint type {key[:12]}: baked on {t['worker']} in {t['seconds']:.1f} s ({', '.join(t['computed'])})"
+            )
+        else:
+            lines.append(f"paint type {key[:12]}: found baked ({t['worker']})")
     return "\n".join(lines)
 
 
@@ -345,9 +404,27 @@ def parse(argv):
     parser.add_argument("--pack", action="store_true", help="pack the weight images into the .blend")
     parser.add_argument("--report", metavar="FILE", help="write the JSON report here")
     parser.add_argument("--jobs", type=int, default=1, metavar="N", help="files baked in parallel processes")
+    parser.add_argument(
+        "--store", metavar="DIR", help="bake every paint type into this folder (default: //paint_lut beside each file)"
+    )
+    parser.add_argument(
+        "--scheduler",
+        metavar="ADDR",
+        help="bake on a Dask cluster: local:N (N worker processes here) or a scheduler address, tcp://host:8786",
+    )
+    parser.add_argument("--scan", action="store_true", help=argparse.SUPPRESS)  # the farm's first phase
     args = parser.parse_args(argv)
     if args.jobs < 1:
         parser.error(f"--jobs must be an integer >= 1, got {args.jobs}")
+    if args.scheduler is not None:
+        try:
+            farm.validate_scheduler(args.scheduler)
+        except ValueError as exc:
+            parser.error(f"--scheduler: {exc}")
+        if args.jobs > 1:
+            parser.error("--jobs and --scheduler exclude each other: the cluster's workers bake in parallel")
+    if args.store is not None and pathlib.Path(args.store).exists() and not pathlib.Path(args.store).is_dir():
+        parser.error(f"--store {args.store}: not a directory")
     if args.report:
         problem = report_problem(pathlib.Path(args.report))
         if problem:
@@ -393,8 +470,14 @@ def bake_here(args):
     registered = hasattr(bpy.types.Material, "paint_lut")
     if not registered:
         package.register()
+    options = {"directory": pathlib.Path(args.store).resolve()} if args.store else {}
     try:
-        return [bake_file(path, force=args.force, pack=args.pack) for path in progress(args.files, len(args.files))]
+        if args.scan:
+            return [scan_file(path, args.store) for path in args.files]
+        return [
+            bake_file(path, force=args.force, pack=args.pack, **options)
+            for path in progress(args.files, len(args.files))
+        ]
     finally:
         if not registered:
             package.unregister()
@@ -432,6 +515,7 @@ def bake_parallel(args, script=None):
 
 def _bake_in_children(args, tmp, prefix):
     flags = [*(["--force"] if args.force else []), *(["--pack"] if args.pack else [])]
+    flags += ["--store", str(pathlib.Path(args.store).resolve())] if args.store else []
 
     def one(i, path):
         report = tmp / f"{i}.json"
@@ -457,7 +541,20 @@ def main(argv=None, *, script=None) -> int:
     130 when interrupted."""
     args = parse(script_argv() if argv is None else argv)
     try:
-        if args.jobs > 1 and len(args.files) > 1:
+        if args.scheduler is not None:
+            try:
+                entries = farm.run(
+                    args.files,
+                    args.scheduler,
+                    child=child_command(script),
+                    store=args.store,
+                    force=args.force,
+                    pack=args.pack,
+                )
+            except farm.FarmUnavailable as exc:
+                print(f"error: {exc}", file=sys.stderr)
+                return 2
+        elif args.jobs > 1 and len(args.files) > 1:
             entries = bake_parallel(args, script)
         else:
             entries = bake_here(args)

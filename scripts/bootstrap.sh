@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Create (or reuse) the virtual environment at .venv in the repository root and
-# install the pinned dependencies from requirements.txt into it.  When a Python
+# install the pinned dependencies from requirements.txt into it, and the farm
+# command's (requirements-farm.txt: Dask distributed) so its tests run.  When a Python
 # 3.13 is available (python3.13 on the PATH, or pyenv's), also create
 # .venv-bpy52 from requirements-bpy52.txt: Blender 5.2 LTS as a module, for
 # the Blender tests (.ci/run).  Re-running is cheap: pip is only invoked when
@@ -13,10 +14,10 @@ if [ ! -x .venv/bin/python ]; then
     "$python" -m venv .venv
 fi
 stamp=.venv/.requirements.sha256
-want="$(sha256sum requirements.txt | cut -d' ' -f1)"
+want="$(cat requirements.txt requirements-farm.txt | sha256sum | cut -d' ' -f1)"
 if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
     .venv/bin/python -m pip install --quiet --upgrade pip
-    .venv/bin/python -m pip install --quiet -r requirements.txt
+    .venv/bin/python -m pip install --quiet -r requirements.txt -r requirements-farm.txt
     echo "$want" > "$stamp"
 fi
 

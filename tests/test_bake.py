@@ -3,6 +3,9 @@ accuracy, metadata, cache, and files that are damaged, foreign or
 interrupted."""
 
 import json
+import pathlib
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -282,3 +285,28 @@ def test_a_lut_keyed_by_its_whole_meta_still_reads(tmp_path, monkeypatch):
         else:
             with pytest.raises(lut.LUTError, match="header key does not match its meta"):
                 lutfile.read(path)
+
+
+def test_processes_racing_to_bake_one_type_into_one_store_leave_one_valid_set(tmp_path):
+    """Four processes bake one paint type into one folder at once (a farm's
+    shared store): each write is a complete file renamed into place, so
+    one LUT and one weights file per engine stand, valid, and no partial
+    file is left."""
+    from lut.render import fitting
+
+    root = str(pathlib.Path(__file__).resolve().parents[1])
+    store = tmp_path / "store"
+    code = (
+        f"import sys; sys.path.insert(0, {root!r}); import lut; from lut.render import bake; "
+        f"bake.bake_for_render(lut.Paint(rho=(0.2, 0.3, 0.4), slope=0.3), {str(store)!r})"
+    )
+    racers = [subprocess.Popen([sys.executable, "-c", code], stderr=subprocess.PIPE) for _ in range(4)]
+    for racer in racers:
+        _, err = racer.communicate(timeout=300)
+        assert racer.returncode == 0, err.decode()
+    luts = list(store.glob("paintlut-*.exr"))
+    fits = sorted(store.glob("paintfit-*.exr"))
+    assert len(luts) == 1 and len(fits) == 2
+    table = lut.load_lut(luts[0])  # verified against its hash
+    assert all(fitting.read_fit(f).lut_key == table.key for f in fits)
+    assert not [p for p in store.iterdir() if p.name.startswith(".")]

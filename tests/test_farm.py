@@ -1,0 +1,156 @@
+"""Batch baking on a Dask cluster (``lut.farm``, ``--scheduler``): each
+paint type baked once for a whole run into one shared store, every file
+wired and saved, a second run computing nothing, a worker killed mid-bake
+costing a retry and no partial file, and the optional dependency's absence
+named in one line."""
+
+from __future__ import annotations
+
+import json
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+bpy = pytest.importorskip("bpy")
+pytest.importorskip("distributed")
+
+from addon import api, batch  # noqa: E402
+from lut import farm  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+SCRIPT = ROOT / "scripts" / "batch_bake.py"
+
+pytestmark = pytest.mark.usefixtures("addon_registered")
+
+#: Three smooth paint types (quick to bake), told apart by their index.
+TYPE_N = (1.4, 1.5, 1.6)
+
+
+def make_shot(path, types, colours):
+    """A .blend with one triangle per material, material i of paint type
+    ``types[i]`` (an index of TYPE_N) and colour ``colours[i]``."""
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    scene = bpy.context.scene
+    for i, (t, rho) in enumerate(zip(types, colours, strict=True)):
+        material = bpy.data.materials.new(f"paint {i}")
+        material.paint_lut.enabled = True
+        material.paint_lut.slope = 0.0
+        material.paint_lut.n = TYPE_N[t]
+        material.paint_lut.rho = rho
+        mesh = bpy.data.meshes.new(f"mesh {i}")
+        mesh.from_pydata([(0, 0, 0), (1, 0, 0), (0, 1, 0)], [], [(0, 1, 2)])
+        mesh.materials.append(material)
+        scene.collection.objects.link(bpy.data.objects.new(f"object {i}", mesh))
+    path.parent.mkdir(parents=True, exist_ok=True)
+    bpy.ops.wm.save_as_mainfile(filepath=str(path))
+    return path
+
+
+def shots(root):
+    """8 files in 3 folders sharing the 3 paint types in other colours."""
+    layout = [
+        ("a/1.blend", (0, 1)),
+        ("a/2.blend", (1,)),
+        ("a/3.blend", (2, 0)),
+        ("b/4.blend", (0,)),
+        ("b/5.blend", (2,)),
+        ("b/6.blend", (1, 2)),
+        ("c/7.blend", (0, 1, 2)),
+        ("c/8.blend", (2,)),
+    ]
+    out = []
+    for k, (name, types) in enumerate(layout):
+        colours = [(0.1 + 0.1 * k, 0.2 + 0.05 * i, 0.5) for i in range(len(types))]
+        out.append(make_shot(root / name, types, colours))
+    return out
+
+
+def run(*args):
+    return subprocess.run([sys.executable, str(SCRIPT), *map(str, args)], capture_output=True, text=True)
+
+
+def current(path, store):
+    """Whether every paint material of the saved file is wired to a current
+    bake in the store, its LUT referenced relative to the .blend."""
+    bpy.ops.wm.open_mainfile(filepath=str(path))
+    materials = [m for m in bpy.data.materials if m.paint_lut.enabled]
+    return bool(materials) and all(
+        api.is_current(m, api.paint_of(m), directory=store) and m.paint_lut.lut_path.startswith("//") for m in materials
+    )
+
+
+def test_each_type_is_baked_once_for_the_whole_run_and_a_second_run_computes_nothing(tmp_path):
+    files = shots(tmp_path / "shots")
+    bogus = tmp_path / "shots" / "c" / "bogus.blend"
+    bogus.write_text("not a blend file")
+    store = tmp_path / "store"
+    report = tmp_path / "report.json"
+
+    done = run(*files, bogus, "--scheduler", "local:2", "--store", store, "--report", report)
+    assert done.returncode == 1, done.stderr  # the bogus file fails alone
+    entries = json.loads(report.read_text())
+    assert [e["file"] for e in entries] == [str(f.resolve()) for f in [*files, bogus]]
+    assert entries[-1]["status"] == "failed" and "not a .blend file" in entries[-1]["reason"]
+    assert all(e["status"] == "saved" for e in entries[:-1]), [e.get("reason") for e in entries]
+    types = {key: t for e in entries for key, t in e.get("types", {}).items()}
+    assert len(types) == 3
+    assert all(t["computed"] == ["lut", "CYCLES", "EEVEE"] for t in types.values())
+    assert all(t["worker"] and t["seconds"] > 0 for t in types.values())
+    # Every file that renders a type reports the same one bake of it.
+    for e in entries[:-1]:
+        for key, t in e["types"].items():
+            assert t == types[key]
+    assert len(list(store.glob("paintlut-*.exr"))) == 3
+    assert not list(store.glob(".*partial*"))
+    assert not list((tmp_path / "shots").rglob("paint_lut"))  # nothing beside the files
+    assert "baked on" in done.stdout
+    assert all(current(f, store) for f in files)
+
+    again = run(*files, "--scheduler", "local:2", "--store", store, "--report", report)
+    assert again.returncode == 0, again.stderr
+    entries = json.loads(report.read_text())
+    assert all(e["status"] == "unchanged" for e in entries)
+    assert all(t["computed"] == [] for e in entries for t in e["types"].values())
+
+
+def test_a_worker_killed_mid_bake_costs_a_retry_and_leaves_no_partial_file(tmp_path, monkeypatch):
+    import farm_tasks
+
+    monkeypatch.setenv("PYTHONPATH", str(pathlib.Path(farm_tasks.__file__).parent))  # the workers import it
+
+    files = shots(tmp_path / "shots")[:3]
+    store = tmp_path / "store"
+    entries = farm.run(files, "local:2", child=batch.child_command(), store=store, bake=farm_tasks.bake_killed_once)
+    assert (store / "killed-once").exists()  # a worker was killed
+    assert all(e["status"] == "saved" for e in entries), [e.get("reason") for e in entries]
+    types = {key: t for e in entries for key, t in e["types"].items()}
+    assert len(types) == 3 and all("failed" not in t for t in types.values())
+    assert not list(store.glob(".*partial*"))
+    assert all(current(f, store) for f in files)
+
+
+def test_without_dask_the_scheduler_flag_says_what_to_install(tmp_path):
+    blend = shots(tmp_path)[0]
+    code = (
+        f"import sys; sys.modules['distributed'] = None; sys.path.insert(0, {str(ROOT)!r}); "
+        f"from addon import batch; sys.exit(batch.main([{str(blend)!r}, '--scheduler', 'local:1']))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 2
+    assert "pip install -r requirements-farm.txt" in done.stderr.strip().splitlines()[-1]
+
+
+@pytest.mark.parametrize(
+    ("flags", "message"),
+    [
+        (["--scheduler", "local:0"], "local:N with N a whole number >= 1"),
+        (["--scheduler", "somehost"], "tcp://host:8786"),
+        (["--scheduler", "local:2", "--jobs", "2"], "exclude each other"),
+    ],
+)
+def test_bad_scheduler_flags_are_refused_before_any_work(tmp_path, flags, message):
+    done = run(tmp_path / "none.blend", *flags)
+    assert done.returncode == 2
+    assert message in done.stderr
