@@ -412,6 +412,13 @@ def parse(argv):
         metavar="ADDR",
         help="bake on a Dask cluster: local:N (N worker processes here) or a scheduler address, tcp://host:8786",
     )
+    parser.add_argument(
+        "--files-per-task",
+        type=int,
+        default=farm.FILES_PER_TASK,
+        metavar="N",
+        help=f"with --scheduler: files per Blender process on a worker (default {farm.FILES_PER_TASK})",
+    )
     parser.add_argument("--scan", action="store_true", help=argparse.SUPPRESS)  # the farm's first phase
     args = parser.parse_args(argv)
     if args.jobs < 1:
@@ -423,6 +430,8 @@ def parse(argv):
             parser.error(f"--scheduler: {exc}")
         if args.jobs > 1:
             parser.error("--jobs and --scheduler exclude each other: the cluster's workers bake in parallel")
+    if args.files_per_task < 1:
+        parser.error(f"--files-per-task must be an integer >= 1, got {args.files_per_task}")
     if args.store is not None and pathlib.Path(args.store).exists() and not pathlib.Path(args.store).is_dir():
         parser.error(f"--store {args.store}: not a directory")
     if args.report:
@@ -550,6 +559,7 @@ def main(argv=None, *, script=None) -> int:
                     store=args.store,
                     force=args.force,
                     pack=args.pack,
+                    files_per_task=args.files_per_task,
                 )
             except farm.FarmUnavailable as exc:
                 print(f"error: {exc}", file=sys.stderr)

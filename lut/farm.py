@@ -3,8 +3,8 @@ into one shared store.
 
 The plan (``run``) has three phases, each a set of Dask tasks:
 
-1. **Scan**, one task per .blend file: a fresh Blender child process opens
-   the file and lists the paint types its used materials need
+1. **Scan**, one task per few .blend files (``FILES_PER_TASK``): a fresh
+   Blender child process opens each file and lists the paint types its used materials need
    (``addon.batch`` with ``--scan``): the paint, and the Blender's Metallic
    lobe and EEVEE calibration its fits are made for.
 2. **Bake**, one task per distinct type (its LUT key, lobe and calibration):
@@ -15,8 +15,9 @@ The plan (``run``) has three phases, each a set of Dask tasks:
    lost worker; an exception is retried ``retries`` times).  Two processes
    baking one type at once each write a complete file and the last rename
    stands: one valid file either way.
-3. **Wire**, one task per file, started as soon as its types are baked: a
-   fresh Blender child process bakes the file against the store (finding
+3. **Wire**, one task per scanned chunk of files, started as soon as their
+   types are baked: a fresh Blender child process bakes the files against
+   the store (finding
    every type cached), wires its materials and saves it, as a local batch
    run does (``addon.batch`` with ``--store``).
 
@@ -29,7 +30,7 @@ the same path).  This module never imports ``bpy``; it needs ``distributed``
 The report is a local run's (one entry per file), each file entry with
 ``types``: per paint type it renders, where and how long it was baked
 (``worker``, ``seconds``, ``computed``: what the bake computed, empty when
-it found the type baked)."""
+it found the type baked; ``store``: the folder)."""
 
 from __future__ import annotations
 
@@ -146,17 +147,19 @@ def close(client) -> None:
 # ----------------------------------------------------------------------------- tasks (run on workers)
 
 
-def run_child(command: list, path: str, extra: list) -> dict:
-    """Run one Blender child on one file and return its report entry (the
-    child's ``--report``); a child that writes none fails the file with the
-    last line it printed."""
+def run_child(command: list, paths: list, extra: list) -> list:
+    """Run one Blender child on some files and return their report entries
+    (the child's ``--report``); a child that writes none fails each file
+    with the last line it printed."""
     with tempfile.TemporaryDirectory(prefix="paint_lut_farm") as tmp:
         report = pathlib.Path(tmp) / "report.json"
-        done = subprocess.run([*command, path, "--report", str(report), *extra], capture_output=True, text=True)
+        done = subprocess.run([*command, *paths, "--report", str(report), *extra], capture_output=True, text=True)
         if report.exists():
-            return json.loads(report.read_text())[0]
+            return json.loads(report.read_text())
     reason = (done.stderr.strip().splitlines() or [f"the Blender child exited with status {done.returncode}"])[-1]
-    return {"file": str(pathlib.Path(path).resolve()), "status": "failed", "reason": reason, "materials": {}}
+    return [
+        {"file": str(pathlib.Path(p).resolve()), "status": "failed", "reason": reason, "materials": {}} for p in paths
+    ]
 
 
 def bake_type(spec: dict, store: str, force: bool = False) -> dict:
@@ -182,10 +185,10 @@ def bake_type(spec: dict, store: str, force: bool = False) -> dict:
     }
 
 
-def wire_file(command: list, path: str, extra: list, baked: list) -> dict:
-    """Phase 3: the file baked against the store (its types' bakes,
-    ``baked``, are done: Dask starts this task once they are)."""
-    return run_child(command, path, extra)
+def wire_files(command: list, paths: list, extra: list, baked: list) -> list:
+    """Phase 3: files baked against the store once their types' bakes
+    (``baked``) are done (Dask starts this task then)."""
+    return run_child(command, paths, extra)
 
 
 # ----------------------------------------------------------------------------- the plan
@@ -199,6 +202,11 @@ def type_id(spec: dict) -> str:
     return f"{spec['key']}:{'metallic' if spec['exact_metallic'] else 'ggx'}:{cal}"
 
 
+#: Files per Blender child (a scan or wire task): a child's start (Blender
+#: and the add-on) costs about as much as opening and saving a few files.
+FILES_PER_TASK = 4
+
+
 def run(
     files,
     scheduler: str,
@@ -207,63 +215,67 @@ def run(
     store=None,
     force=False,
     pack=False,
+    files_per_task=FILES_PER_TASK,
     bake=bake_type,
 ) -> list:
     """Bake ``files`` on a Dask cluster (module docstring): returns the
     report, one entry per file in the order given.  ``child``: the command
     that starts a Blender child running ``addon.batch`` (its arguments
     follow); ``store``: where every type's LUT and fits go (None: each
-    file's own ``//paint_lut``, types still baked once per folder);
-    ``bake``: the phase 2 task (``bake_type``)."""
+    file's own ``//paint_lut``, types baked once per folder);
+    ``files_per_task``: files per Blender child; ``bake``: the phase 2 task
+    (``bake_type``)."""
+    distributed = _distributed()
     files = [str(pathlib.Path(f).resolve()) for f in files]
+    if int(files_per_task) < 1:
+        raise ValueError(f"files_per_task must be a whole number >= 1, got {files_per_task!r}")
+    chunks = [files[i : i + int(files_per_task)] for i in range(0, len(files), int(files_per_task))]
     if store is not None:
         store = str(pathlib.Path(store).resolve())
         pathlib.Path(store).mkdir(parents=True, exist_ok=True)
+    store_args = ["--store", store] if store else []
+    extra = [*store_args, *(["--pack"] if pack else [])]
     client = client_for(scheduler)
     try:
-        store_args = ["--store", store] if store else []
-        scans = client.gather(
-            client.map(run_child, [child] * len(files), files, [["--scan", *store_args]] * len(files), pure=False)
-        )
-        bakes, where = {}, {}
-        for path, scan in zip(files, scans, strict=True):
-            if scan.get("status") == "failed":
-                continue
-            for spec in scan.get("paint_types", []):
-                directory = spec["store"]
-                key = (type_id(spec), directory)
-                where.setdefault(path, []).append(key)
-                if key not in bakes:
-                    bakes[key] = client.submit(bake, spec, directory, force, retries=RETRIES, pure=False)
-        extra = [*store_args, *(["--pack"] if pack else [])]
-        wires = {}
-        for path, scan in zip(files, scans, strict=True):
-            if scan.get("status") == "failed":
-                continue
-            deps = [bakes[k] for k in where.get(path, [])]
-            wires[path] = client.submit(wire_file, child, path, extra, deps, pure=False)
+        scans = {client.submit(run_child, child, chunk, ["--scan", *store_args], pure=False): chunk for chunk in chunks}
+        entries, bakes, where, wires = {}, {}, {}, {}
+        # Each chunk's types are baked, and its files wired, as soon as it is scanned.
+        for future in distributed.as_completed(scans):
+            scanned = [e for e in future.result() if e.get("status") != "failed"]
+            entries.update((e["file"], e) for e in future.result())
+            keys = []
+            for entry in scanned:
+                for spec in entry.get("paint_types", []):
+                    key = (type_id(spec), spec["store"])
+                    where.setdefault(entry["file"], []).append(key)
+                    keys.append(key)
+                    if key not in bakes:
+                        bakes[key] = client.submit(bake, spec, spec["store"], force, retries=RETRIES, pure=False)
+            if scanned:
+                paths = [e["file"] for e in scanned]
+                wires[tuple(paths)] = client.submit(
+                    wire_files, child, paths, extra, [bakes[k] for k in dict.fromkeys(keys)], pure=False
+                )
         done = {}
         for key, future in bakes.items():
             try:
-                done[key] = future.result()
+                done[key] = {**future.result(), "store": key[1]}
             except Exception as exc:  # the wire phase bakes (or fails) the type itself and says why
-                done[key] = {"failed": f"{type(exc).__name__}: {exc}"}
-        for path in wires:
-            if any("failed" in done[k] for k in where.get(path, [])):
-                # A failed bake fails the tasks that wait on it: wire the file
-                # anyway, its child bakes the type itself or reports why not.
-                wires[path] = client.submit(wire_file, child, path, extra, [], pure=False)
-        entries = []
-        for path, scan in zip(files, scans, strict=True):
-            if path not in wires:
-                entries.append(scan)
-                continue
+                done[key] = {"failed": f"{type(exc).__name__}: {exc}", "store": key[1]}
+        for paths in list(wires):
+            if any("failed" in done[k] for p in paths for k in where.get(p, [])):
+                # A failed bake fails the tasks that wait on it: wire the files
+                # anyway, their child bakes the type itself or reports why not.
+                wires[paths] = client.submit(wire_files, child, list(paths), extra, [], pure=False)
+        for paths, future in wires.items():
             try:
-                entry = wires[path].result()
+                wired = future.result()
             except Exception as exc:
-                entry = {"file": path, "status": "failed", "reason": f"{type(exc).__name__}: {exc}", "materials": {}}
-            entry["types"] = {k[0].partition(":")[0]: done[k] for k in dict.fromkeys(where.get(path, []))}
-            entries.append(entry)
-        return entries
+                reason = f"{type(exc).__name__}: {exc}"
+                wired = [{"file": p, "status": "failed", "reason": reason, "materials": {}} for p in paths]
+            for entry in wired:
+                entry["types"] = {k[0].partition(":")[0]: done[k] for k in dict.fromkeys(where.get(entry["file"], []))}
+                entries[entry["file"]] = entry
+        return [entries[f] for f in files]
     finally:
         close(client)

@@ -148,6 +148,7 @@ def test_without_dask_the_scheduler_flag_says_what_to_install(tmp_path):
         (["--scheduler", "local:0"], "local:N with N a whole number >= 1"),
         (["--scheduler", "somehost"], "tcp://host:8786"),
         (["--scheduler", "local:2", "--jobs", "2"], "exclude each other"),
+        (["--scheduler", "local:2", "--files-per-task", "0"], "--files-per-task must be an integer >= 1"),
     ],
 )
 def test_bad_scheduler_flags_are_refused_before_any_work(tmp_path, flags, message):
