@@ -119,7 +119,12 @@ def store_result(material, paint: lut.Paint, result: render_bake.RenderBake, exa
     (``clear_stale``) clear the stale flag."""
     settings = material.paint_lut
     path = result.lut_path
-    settings.lut_path = bpy.path.relpath(str(path)) if bpy.data.filepath else str(path)
+    settings.lut_path = str(path)
+    if bpy.data.filepath:
+        try:
+            settings.lut_path = bpy.path.relpath(str(path))
+        except ValueError:  # another drive (Windows): keep it absolute
+            pass
     groups = {
         target: nodes.build_group(fit, result.fit_paths[target], exact_metallic) for target, fit in result.fits.items()
     }

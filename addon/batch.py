@@ -32,9 +32,11 @@ import importlib
 import json
 import os
 import pathlib
+import signal
 import subprocess
 import sys
 import tempfile
+import threading
 import tomllib
 
 import bpy
@@ -173,16 +175,19 @@ def linked_status(material, exact_metallic=None) -> dict:
     return {"status": "linked", "library": str(library), "baked": baked, "reason": reason}
 
 
-def bake_one(material, used, force=False, **options) -> dict:
+def bake_one(material, used, force=False, rewire=False, **options) -> dict:
     """Bake one paint material if it is used and not current; its report
-    entry.  Any exception fails this material alone, with its reason."""
+    entry.  ``force``: bake it again; ``rewire``: wire it anew from its
+    type's bake even when current (a farm's forced run, whose types were
+    baked again already).  Any exception fails this material alone, with
+    its reason."""
     if material.library is not None:
         return linked_status(material, options.get("exact_metallic")) if material in used else {"status": "unused"}
     if material not in used:
         return {"status": "unused"}
     try:
         paint = api.paint_of(material)
-        if not force and api.is_current(material, paint, **options):
+        if not (force or rewire) and api.is_current(material, paint, **options):
             return {"status": "cached", **_fit_entry(material)}
         result = api.bake_material(material, force=force, **options)
     except (ValueError, OSError, RuntimeError) as exc:
@@ -288,7 +293,7 @@ def scan_file(path, store=None) -> dict:
     return entry
 
 
-def bake_file(path, force=False, pack=False, **options) -> dict:
+def bake_file(path, force=False, pack=False, rewire=False, **options) -> dict:
     """Bake one .blend file.  Returns its report entry: {"file", "status"
     ("saved", "unchanged" or "failed"), "reason" (when failed), "materials":
     {name: {"status": "baked" | "cached" | "unused" | "linked" | "failed",
@@ -302,7 +307,7 @@ def bake_file(path, force=False, pack=False, **options) -> dict:
         return entry
     for material in list(bpy.data.materials):
         if material.paint_lut.enabled:
-            entry["materials"][_report_name(material)] = bake_one(material, used, force=force, **options)
+            entry["materials"][_report_name(material)] = bake_one(material, used, force=force, rewire=rewire, **options)
     shared = shared_bakes(entry["materials"])
     if shared:
         entry["shared"] = shared
@@ -379,16 +384,21 @@ def summary(entries) -> str:
                 lines.append(f"  {name}: fit misses its target: {', '.join(m['fit_misses'])}")
         for key, names in entry.get("shared", {}).items():
             lines.append(f"  one bake of paint type {key[:12]} shared by {', '.join(names)}")
-    types = {key: t for entry in entries for key, t in entry.get("types", {}).items()}  # a farm run's bakes
-    for key, t in types.items():
+    # A farm run's bakes: one per type and folder (a type used in two
+    # folders without a shared store is baked in each).
+    types = {(key, t.get("store")): t for entry in entries for key, t in entry.get("types", {}).items()}
+    folders = {store for _, store in types}
+    for (key, store), t in types.items():
+        where = f" in {store}" if len(folders) > 1 else ""
         if "failed" in t:
-            lines.append(f"paint type {key[:12]}: its bake failed on the cluster ({t['failed']})")
+            lines.append(f"paint type {key[:12]}{where}: its bake failed on the cluster ({t['failed']})")
         elif t["computed"]:
             lines.append(
-                f"paint type {key[:12]}: baked on {t['worker']} in {t['seconds']:.1f} s ({', '.join(t['computed'])})"
+                f"paint type {key[:12]}{where}: baked on {t['worker']} in {t['seconds']:.1f} s"
+                f" ({', '.join(t['computed'])})"
             )
         else:
-            lines.append(f"paint type {key[:12]}: found baked ({t['worker']})")
+            lines.append(f"paint type {key[:12]}{where}: found baked ({t['worker']})")
     return "\n".join(lines)
 
 
@@ -420,6 +430,7 @@ def parse(argv):
         help=f"with --scheduler: files per Blender process on a worker (default {farm.FILES_PER_TASK})",
     )
     parser.add_argument("--scan", action="store_true", help=argparse.SUPPRESS)  # the farm's first phase
+    parser.add_argument("--rewire", action="store_true", help=argparse.SUPPRESS)  # a farm's forced run, phase 3
     args = parser.parse_args(argv)
     if args.jobs < 1:
         parser.error(f"--jobs must be an integer >= 1, got {args.jobs}")
@@ -432,8 +443,11 @@ def parse(argv):
             parser.error("--jobs and --scheduler exclude each other: the cluster's workers bake in parallel")
     if args.files_per_task < 1:
         parser.error(f"--files-per-task must be an integer >= 1, got {args.files_per_task}")
-    if args.store is not None and pathlib.Path(args.store).exists() and not pathlib.Path(args.store).is_dir():
-        parser.error(f"--store {args.store}: not a directory")
+    if args.store is not None:
+        store = pathlib.Path(args.store)
+        blocker = next((p for p in (store, *store.parents) if p.exists()), None)
+        if blocker is not None and not blocker.is_dir():
+            parser.error(f"--store {args.store}: {blocker} is not a directory")
     if args.report:
         problem = report_problem(pathlib.Path(args.report))
         if problem:
@@ -484,7 +498,7 @@ def bake_here(args):
         if args.scan:
             return [scan_file(path, args.store) for path in args.files]
         return [
-            bake_file(path, force=args.force, pack=args.pack, **options)
+            bake_file(path, force=args.force, pack=args.pack, rewire=args.rewire, **options)
             for path in progress(args.files, len(args.files))
         ]
     finally:
@@ -540,6 +554,10 @@ def _bake_in_children(args, tmp, prefix):
         return [f.result() for f in progress(futures, len(futures))]
 
 
+def _terminated(signum, frame):
+    raise KeyboardInterrupt
+
+
 def main(argv=None, *, script=None) -> int:
     """The batch command line (``argv``: default the arguments after '--'
     inside Blender, else the command line's).  ``script``: the file the
@@ -549,6 +567,9 @@ def main(argv=None, *, script=None) -> int:
     holds no current bake), 2 on bad arguments or an unwritable report,
     130 when interrupted."""
     args = parse(script_argv() if argv is None else argv)
+    if args.scheduler is not None and threading.current_thread() is threading.main_thread():
+        # A job killer's SIGTERM unwinds like Ctrl-C, so the local cluster stops.
+        signal.signal(signal.SIGTERM, _terminated)
     try:
         if args.scheduler is not None:
             try:

@@ -95,9 +95,13 @@ def client_for(scheduler: str):
     env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
     common = ["--scheduler-file", str(address), "--no-dashboard", "--host", "127.0.0.1"]
     log = open(folder / "cluster.log", "wb")  # noqa: SIM115 (closed in close)
+    # Should this process die without stopping them (SIGKILL), the scheduler
+    # stops once no client has used it for a while, and the workers once
+    # their scheduler is gone.
     processes = [
         subprocess.Popen(
-            [sys.executable, "-m", "distributed.cli.dask_scheduler", *common, "--port", "0"],
+            [sys.executable, "-m", "distributed.cli.dask_scheduler", *common, "--port", "0",
+             "--idle-timeout", LOCAL_IDLE_TIMEOUT],
             env=env, stdout=log, stderr=subprocess.STDOUT,
         ),
     ]  # fmt: skip
@@ -105,12 +109,12 @@ def client_for(scheduler: str):
         deadline = time.monotonic() + 60
         while not address.exists():
             if processes[0].poll() is not None or time.monotonic() > deadline:
-                raise RuntimeError(f"the local Dask scheduler did not start (see {folder / 'cluster.log'})")
+                raise RuntimeError("the local Dask scheduler did not start: " + _tail(folder / "cluster.log"))
             time.sleep(0.1)
         processes.append(
             subprocess.Popen(
                 [sys.executable, "-m", "distributed.cli.dask_worker", *common,
-                 "--nworkers", str(count), "--nthreads", "1"],
+                 "--nworkers", str(count), "--nthreads", "1", "--death-timeout", LOCAL_DEATH_TIMEOUT],
                 env=env, stdout=log, stderr=subprocess.STDOUT,
             )
         )  # fmt: skip
@@ -121,6 +125,18 @@ def client_for(scheduler: str):
         raise
     client._paint_lut_local = (processes, log, folder)  # stopped with the client (close)
     return client
+
+
+#: How long a local cluster outlives a client that died without stopping it.
+LOCAL_IDLE_TIMEOUT = "120s"
+LOCAL_DEATH_TIMEOUT = "60s"
+
+
+def _tail(path, lines=5) -> str:
+    try:
+        return " | ".join(path.read_text(errors="replace").strip().splitlines()[-lines:]) or "no output"
+    except OSError:
+        return "no output"
 
 
 def _stop(processes, log, folder):
@@ -139,27 +155,34 @@ def _stop(processes, log, folder):
 def close(client) -> None:
     """Close a client of ``client_for`` and stop its local cluster, if any."""
     local = getattr(client, "_paint_lut_local", None)
-    client.close()
-    if local is not None:
-        _stop(*local)
+    try:
+        client.close()
+    finally:
+        if local is not None:
+            _stop(*local)
 
 
 # ----------------------------------------------------------------------------- tasks (run on workers)
 
 
 def run_child(command: list, paths: list, extra: list) -> list:
-    """Run one Blender child on some files and return their report entries
-    (the child's ``--report``); a child that writes none fails each file
-    with the last line it printed."""
+    """Run one Blender child on some files and return their report entries,
+    in the order of ``paths`` (the child's ``--report``).  A child that
+    writes none (it crashed) is run again on each file alone, so the file
+    that crashes it fails alone, with the child's exit status and the last
+    line it printed."""
     with tempfile.TemporaryDirectory(prefix="paint_lut_farm") as tmp:
         report = pathlib.Path(tmp) / "report.json"
         done = subprocess.run([*command, *paths, "--report", str(report), *extra], capture_output=True, text=True)
         if report.exists():
-            return json.loads(report.read_text())
-    reason = (done.stderr.strip().splitlines() or [f"the Blender child exited with status {done.returncode}"])[-1]
-    return [
-        {"file": str(pathlib.Path(p).resolve()), "status": "failed", "reason": reason, "materials": {}} for p in paths
-    ]
+            entries = json.loads(report.read_text())
+            if len(entries) == len(paths):
+                return entries
+    if len(paths) > 1:
+        return [entry for path in paths for entry in run_child(command, [path], extra)]
+    last = (done.stderr.strip().splitlines() or ["no output"])[-1]
+    reason = f"the Blender child exited with status {done.returncode} ({last})"
+    return [{"file": str(pathlib.Path(paths[0]).resolve()), "status": "failed", "reason": reason, "materials": {}}]
 
 
 def bake_type(spec: dict, store: str, force: bool = False) -> dict:
@@ -222,40 +245,50 @@ def run(
     report, one entry per file in the order given.  ``child``: the command
     that starts a Blender child running ``addon.batch`` (its arguments
     follow); ``store``: where every type's LUT and fits go (None: each
-    file's own ``//paint_lut``, types baked once per folder);
-    ``files_per_task``: files per Blender child; ``bake``: the phase 2 task
-    (``bake_type``)."""
+    file's own ``//paint_lut``, types baked once per folder); ``force``:
+    bake every type again (and wire every file anew); ``files_per_task``:
+    files per Blender child; ``bake``: the phase 2 task (``bake_type``)."""
     distributed = _distributed()
-    files = [str(pathlib.Path(f).resolve()) for f in files]
     if int(files_per_task) < 1:
         raise ValueError(f"files_per_task must be a whole number >= 1, got {files_per_task!r}")
-    chunks = [files[i : i + int(files_per_task)] for i in range(0, len(files), int(files_per_task))]
+    given = [str(pathlib.Path(f).resolve()) for f in files]
+    unique = list(dict.fromkeys(given))  # a file listed twice is baked and saved once
+    chunks = [tuple(unique[i : i + int(files_per_task)]) for i in range(0, len(unique), int(files_per_task))]
     if store is not None:
         store = str(pathlib.Path(store).resolve())
         pathlib.Path(store).mkdir(parents=True, exist_ok=True)
     store_args = ["--store", store] if store else []
-    extra = [*store_args, *(["--pack"] if pack else [])]
+    # A forced run's types are baked again in phase 2; its files are wired
+    # anew from those bakes, not baked a second time.
+    extra = [*store_args, *(["--pack"] if pack else []), *(["--rewire"] if force else [])]
     client = client_for(scheduler)
     try:
-        scans = {client.submit(run_child, child, chunk, ["--scan", *store_args], pure=False): chunk for chunk in chunks}
+        scans = {
+            client.submit(run_child, child, list(chunk), ["--scan", *store_args], retries=1, pure=False): chunk
+            for chunk in chunks
+        }
         entries, bakes, where, wires = {}, {}, {}, {}
         # Each chunk's types are baked, and its files wired, as soon as it is scanned.
         for future in distributed.as_completed(scans):
-            scanned = [e for e in future.result() if e.get("status") != "failed"]
-            entries.update((e["file"], e) for e in future.result())
+            chunk = scans[future]
+            try:
+                scanned = dict(zip(chunk, future.result(), strict=True))
+            except Exception as exc:  # e.g. no Blender at that path on the worker's node
+                reason = f"cannot scan on the cluster: {type(exc).__name__}: {exc}"
+                scanned = {p: {"file": p, "status": "failed", "reason": reason, "materials": {}} for p in chunk}
+            entries.update(scanned)
+            ready = [p for p, e in scanned.items() if e.get("status") != "failed"]
             keys = []
-            for entry in scanned:
-                for spec in entry.get("paint_types", []):
+            for path in ready:
+                for spec in scanned[path].get("paint_types", []):
                     key = (type_id(spec), spec["store"])
-                    where.setdefault(entry["file"], []).append(key)
+                    where.setdefault(path, []).append(key)
                     keys.append(key)
                     if key not in bakes:
                         bakes[key] = client.submit(bake, spec, spec["store"], force, retries=RETRIES, pure=False)
-            if scanned:
-                paths = [e["file"] for e in scanned]
-                wires[tuple(paths)] = client.submit(
-                    wire_files, child, paths, extra, [bakes[k] for k in dict.fromkeys(keys)], pure=False
-                )
+            if ready:
+                deps = [bakes[k] for k in dict.fromkeys(keys)]
+                wires[tuple(ready)] = client.submit(wire_files, child, ready, extra, deps, pure=False)
         done = {}
         for key, future in bakes.items():
             try:
@@ -273,9 +306,9 @@ def run(
             except Exception as exc:
                 reason = f"{type(exc).__name__}: {exc}"
                 wired = [{"file": p, "status": "failed", "reason": reason, "materials": {}} for p in paths]
-            for entry in wired:
-                entry["types"] = {k[0].partition(":")[0]: done[k] for k in dict.fromkeys(where.get(entry["file"], []))}
-                entries[entry["file"]] = entry
-        return [entries[f] for f in files]
+            for path, entry in zip(paths, wired, strict=True):
+                entry["types"] = {k[0].partition(":")[0]: done[k] for k in dict.fromkeys(where.get(path, []))}
+                entries[path] = entry
+        return [entries[f] for f in given]
     finally:
         close(client)

@@ -27,3 +27,23 @@ def bake_killed_once(spec, store, force=False):
     time.sleep(0.3)  # into the LUT's tabulation
     os.kill(os.getpid(), signal.SIGKILL)
     return None  # not reached
+
+
+def crash_on(name: str, argv: list) -> None:
+    """A Blender child that dies of a segmentation fault when it is given a
+    file called ``name``, and is ``addon.batch`` otherwise (run as a script:
+    ``python farm_tasks.py NAME ARGS...``)."""
+    if any(pathlib.Path(a).name == name for a in argv):
+        os.kill(os.getpid(), signal.SIGSEGV)
+    import bpy  # noqa: F401  (before the add-on, as batch.child_command does)
+
+    from addon import batch
+
+    raise SystemExit(batch.main(argv))
+
+
+if __name__ == "__main__":
+    import sys
+
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
+    crash_on(sys.argv[1], sys.argv[2:])

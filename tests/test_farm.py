@@ -6,10 +6,12 @@ named in one line."""
 
 from __future__ import annotations
 
+import contextlib
 import json
 import pathlib
 import subprocess
 import sys
+import time
 
 import pytest
 
@@ -88,10 +90,12 @@ def test_each_type_is_baked_once_for_the_whole_run_and_a_second_run_computes_not
     store = tmp_path / "store"
     report = tmp_path / "report.json"
 
-    done = run(*files, bogus, "--scheduler", "local:2", "--store", store, "--report", report)
+    listed = [*files, bogus, files[0]]  # the first file listed twice: baked and saved once
+    done = run(*listed, "--scheduler", "local:2", "--store", store, "--report", report)
     assert done.returncode == 1, done.stderr  # the bogus file fails alone
     entries = json.loads(report.read_text())
-    assert [e["file"] for e in entries] == [str(f.resolve()) for f in [*files, bogus]]
+    assert [e["file"] for e in entries] == [str(f.resolve()) for f in listed]
+    assert entries.pop() == entries[0]
     assert entries[-1]["status"] == "failed" and "not a .blend file" in entries[-1]["reason"]
     assert all(e["status"] == "saved" for e in entries[:-1]), [e.get("reason") for e in entries]
     types = {key: t for e in entries for key, t in e.get("types", {}).items()}
@@ -129,6 +133,67 @@ def test_a_worker_killed_mid_bake_costs_a_retry_and_leaves_no_partial_file(tmp_p
     assert len(types) == 3 and all("failed" not in t for t in types.values())
     assert not list(store.glob(".*partial*"))
     assert all(current(f, store) for f in files)
+
+    # A forced run bakes every type again and wires and saves every file anew.
+    forced = farm.run(files, "local:2", child=batch.child_command(), store=store, force=True)
+    assert all(e["status"] == "saved" for e in forced), [e.get("reason") for e in forced]
+    assert all(t["computed"] == ["lut", "CYCLES", "EEVEE"] for e in forced for t in e["types"].values())
+    assert all(current(f, store) for f in files)
+
+
+def test_a_crashing_child_fails_only_the_file_that_crashes_it(tmp_path):
+    import farm_tasks
+
+    good = shots(tmp_path / "shots")[:2]
+    crash = make_shot(tmp_path / "shots" / "crash.blend", (0,), [(0.5, 0.5, 0.5)])
+    child = [sys.executable, farm_tasks.__file__, "crash.blend"]
+    entries = farm.run([good[0], crash, good[1]], "local:1", child=child, store=tmp_path / "store")
+    assert [e["status"] for e in entries] == ["saved", "failed", "saved"], [e.get("reason") for e in entries]
+    assert "exited with status -11" in entries[1]["reason"]
+    assert all(current(f, tmp_path / "store") for f in good)
+
+
+def test_a_cluster_that_cannot_start_blender_reports_every_file_failed(tmp_path):
+    files = shots(tmp_path / "shots")[:2]
+    entries = farm.run(files, "local:1", child=[str(tmp_path / "no-blender")], store=tmp_path / "store")
+    assert [e["status"] for e in entries] == ["failed", "failed"]
+    assert all("cannot scan on the cluster: FileNotFoundError" in e["reason"] for e in entries)
+
+
+def test_a_terminated_run_stops_its_local_cluster(tmp_path):
+    import psutil
+
+    files = shots(tmp_path / "shots")[:2]
+    process = subprocess.Popen([sys.executable, str(SCRIPT), *map(str, files), "--scheduler", "local:1"])
+    deadline = time.monotonic() + 120
+    cluster = []
+    while time.monotonic() < deadline and not any("dask_worker" in " ".join(c.cmdline()) for c in cluster):
+        time.sleep(0.2)
+        with contextlib.suppress(psutil.Error):
+            cluster = psutil.Process(process.pid).children(recursive=True)
+    assert cluster, "the local cluster never started"
+    process.terminate()
+    assert process.wait(timeout=120) == 130
+    _, alive = psutil.wait_procs(cluster, timeout=60)
+    assert not alive
+
+
+def test_the_summary_counts_one_bake_per_type_and_folder():
+    bake = {"worker": "node:1", "seconds": 1.0, "computed": ["lut", "CYCLES", "EEVEE"]}
+    entries = [
+        {"file": f"/{d}/x.blend", "status": "saved", "materials": {}, "types": {"abc": {**bake, "store": f"/{d}/s"}}}
+        for d in ("a", "b")
+    ]
+    lines = [line for line in batch.summary(entries).splitlines() if line.startswith("paint type")]
+    assert lines == ["paint type abc in /a/s: baked on node:1 in 1.0 s (lut, CYCLES, EEVEE)", lines[1]]
+    assert "in /b/s" in lines[1]
+
+
+def test_a_store_under_a_file_is_refused_before_any_work(tmp_path):
+    (tmp_path / "afile").write_text("")
+    done = run(tmp_path / "none.blend", "--store", tmp_path / "afile" / "store")
+    assert done.returncode == 2
+    assert "is not a directory" in done.stderr
 
 
 def test_without_dask_the_scheduler_flag_says_what_to_install(tmp_path):
