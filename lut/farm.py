@@ -4,22 +4,23 @@ into one shared store.
 The plan (``run``) has three phases, each a set of Dask tasks:
 
 1. **Scan**, one task per few .blend files (``FILES_PER_TASK``): a fresh
-   Blender child process opens each file and lists the paint types its used materials need
-   (``addon.batch`` with ``--scan``): the paint, and the Blender's Metallic
-   lobe and EEVEE calibration its fits are made for.
+   Blender child process opens each file and lists the paint types its
+   used materials need (``addon.batch`` with ``--scan``): the paint, and
+   the Blender's Metallic lobe and EEVEE calibration its fits are made for.
 2. **Bake**, one task per distinct type (its LUT key, lobe and calibration):
    ``lut.render.bake.bake_for_render`` into the store, in the worker itself
    (numpy work, no Blender).  Writes are atomic (``lut.lutfiles.files``), so
    a worker killed mid-bake leaves no partial file under a final name, and
    the task runs again on another worker (Dask reschedules the tasks of a
-   lost worker; an exception is retried ``retries`` times).  Two processes
+   lost worker; an exception is retried ``RETRIES`` times).  Two processes
    baking one type at once each write a complete file and the last rename
    stands: one valid file either way.
 3. **Wire**, one task per scanned chunk of files, started as soon as their
    types are baked: a fresh Blender child process bakes the files against
-   the store (finding
-   every type cached), wires its materials and saves it, as a local batch
-   run does (``addon.batch`` with ``--store``).
+   the store (finding every type cached), wires their materials and saves
+   them, as a local batch run does (``addon.batch`` with ``--store``).  A
+   child that crashes is run again on each of its files alone
+   (``run_child``), so only the file that crashes Blender fails.
 
 Blender's data is one file per process, so Blender work never runs in the
 worker itself: the tasks are handed the command that starts a child (the
