@@ -486,8 +486,8 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None, star
             for p in targets:
                 if allowed[p, k]:
                     idx = [j for j in chosen + [k] if allowed[p, j]]
-                    start = np.pad(solutions[p], ((0, 0), (0, 1)))  # k enters last, at zero
-                    trial_solutions[p], trial[p] = _nnls_fit(gram, rhs[:, p], norm[:, p], idx, upper[idx], start)
+                    warm = np.pad(solutions[p], ((0, 0), (0, 1)))  # k enters last, at zero
+                    trial_solutions[p], trial[p] = _nnls_fit(gram, rhs[:, p], norm[:, p], idx, upper[idx], warm)
             gain = (current - sum(trial.values())) / cost[k]  # error reduction per unit of render cost
             if gain > max(best_gain, 1e-9):
                 best, best_gain, best_errors, best_solutions = k, gain, trial, trial_solutions
