@@ -547,7 +547,7 @@ def _bake_in_children(args, tmp, prefix):
         if report.exists():
             return json.loads(report.read_text())[0]
         reason = (done.stderr.strip().splitlines() or ["no report"])[-1]
-        return {"file": str(pathlib.Path(path).resolve()), "status": "failed", "reason": reason, "materials": {}}
+        return farm.failed_entry(path, reason)
 
     with concurrent.futures.ThreadPoolExecutor(args.jobs) as pool:
         futures = [pool.submit(one, i, path) for i, path in enumerate(args.files)]

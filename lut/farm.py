@@ -166,6 +166,12 @@ def close(client) -> None:
 # ----------------------------------------------------------------------------- tasks (run on workers)
 
 
+def failed_entry(path, reason: str) -> dict:
+    """The report entry of a file that failed as a whole (the batch's
+    format: ``addon.batch.bake_file``), named by its resolved path."""
+    return {"file": str(pathlib.Path(path).resolve()), "status": "failed", "reason": reason, "materials": {}}
+
+
 def run_child(command: list, paths: list, extra: list) -> list:
     """Run one Blender child on some files and return their report entries,
     in the order of ``paths`` (the child's ``--report``).  A child that
@@ -183,7 +189,7 @@ def run_child(command: list, paths: list, extra: list) -> list:
         return [entry for path in paths for entry in run_child(command, [path], extra)]
     last = (done.stderr.strip().splitlines() or ["no output"])[-1]
     reason = f"the Blender child exited with status {done.returncode} ({last})"
-    return [{"file": str(pathlib.Path(paths[0]).resolve()), "status": "failed", "reason": reason, "materials": {}}]
+    return [failed_entry(paths[0], reason)]
 
 
 def bake_type(spec: dict, store: str, force: bool = False) -> dict:
@@ -276,7 +282,7 @@ def run(
                 scanned = dict(zip(chunk, future.result(), strict=True))
             except Exception as exc:  # e.g. no Blender at that path on the worker's node
                 reason = f"cannot scan on the cluster: {type(exc).__name__}: {exc}"
-                scanned = {p: {"file": p, "status": "failed", "reason": reason, "materials": {}} for p in chunk}
+                scanned = {p: failed_entry(p, reason) for p in chunk}
             entries.update(scanned)
             ready = [p for p, e in scanned.items() if e.get("status") != "failed"]
             keys = []
@@ -306,7 +312,7 @@ def run(
                 wired = future.result()
             except Exception as exc:
                 reason = f"{type(exc).__name__}: {exc}"
-                wired = [{"file": p, "status": "failed", "reason": reason, "materials": {}} for p in paths]
+                wired = [failed_entry(p, reason) for p in paths]
             for path, entry in zip(paths, wired, strict=True):
                 entry["types"] = {k[0].partition(":")[0]: done[k] for k in dict.fromkeys(where.get(path, []))}
                 entries[path] = entry
