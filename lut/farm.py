@@ -194,7 +194,8 @@ def run_child(command: list, paths: list, extra: list) -> list:
 
 def bake_type(spec: dict, store: str, force: bool = False) -> dict:
     """Bake one paint type into the store (a task of phase 2): ``spec`` is a
-    scanned type (``paint``, ``exact_metallic``, ``eevee_calibration``).
+    scanned type (``paint``, ``exact_metallic``, ``eevee_calibration``,
+    ``eevee_mode``).
     Returns where and how long: {"worker", "seconds", "computed"}."""
     from .paint.core import Paint
     from .render import bake as render_bake
@@ -206,6 +207,7 @@ def bake_type(spec: dict, store: str, force: bool = False) -> dict:
         store,
         exact_metallic=bool(spec["exact_metallic"]),
         eevee_calibration=tuple(calibration) if calibration else None,
+        eevee_mode=spec.get("eevee_mode", render_bake.fitting.DEFAULT_EEVEE_MODE),
         force=force,
     )
     return {
@@ -225,11 +227,11 @@ def wire_files(command: list, paths: list, extra: list, baked: list) -> list:
 
 
 def type_id(spec: dict) -> str:
-    """A scanned type's identity: its LUT key, lobe kind and calibration
-    (one set of files in the store)."""
+    """A scanned type's identity: its LUT key, lobe kind, calibration and
+    EEVEE mode (one set of files in the store)."""
     calibration = spec.get("eevee_calibration")
     cal = "".join(str(v) for v in calibration[:2]) if calibration else "-"
-    return f"{spec['key']}:{'metallic' if spec['exact_metallic'] else 'ggx'}:{cal}"
+    return f"{spec['key']}:{'metallic' if spec['exact_metallic'] else 'ggx'}:{cal}:{spec.get('eevee_mode', '-')}"
 
 
 #: Files per Blender child (a scan or wire task): a child's start (Blender

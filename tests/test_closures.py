@@ -140,16 +140,16 @@ def test_candidates_per_target():
 
 def test_eevee_fits_keep_to_two_reflection_closures_with_the_mirror(tmp_path):
     """EEVEE sums two reflection closures exactly: a smooth type's mirror is
-    one, so its fit takes at most one more (a retro lobe, for a
-    back-scattering pigment); a rough type's fit at most two lobes."""
+    one, so its exact fit takes at most one more (a retro lobe, for a
+    back-scattering pigment); a rough type's exact fit at most two lobes."""
     from lut.render import eevee
 
     smooth = baking.load_lut(baking.bake(lut.Paint(rho=0.03, single=0.2, g=-0.5), tmp_path))
     rough = baking.load_lut(baking.bake(lut.Paint(rho=0.03, single=0.2, g=-0.5, slope=0.2), tmp_path))
-    smooth_fit = fitting.fit_lut(smooth, "EEVEE", calibration=(5, 0))
+    smooth_fit = fitting.fit_lut(smooth, "EEVEE", calibration=(5, 0), eevee_mode="EXACT")
     assert smooth_fit.mirror
     assert [c.kind for c in smooth_fit.closures if eevee.is_reflection(c)] == ["retro_glossy"]
-    rough_fit = fitting.fit_lut(rough, "EEVEE", calibration=(5, 0))
+    rough_fit = fitting.fit_lut(rough, "EEVEE", calibration=(5, 0), eevee_mode="EXACT")
     assert 1 <= sum(eevee.is_reflection(c) for c in rough_fit.closures) <= eevee.EXACT_REFLECTION_CLOSURES
     assert "retro_glossy" not in {c.kind for c in rough_fit.closures}
 
@@ -291,10 +291,14 @@ def test_facet_dominated_dark_paints_keep_facet_closures(luts):
 def test_fits_respect_the_budget_and_the_mix_factor_bound(luts):
     for name, table in luts.items():
         for target in closures.TARGETS:
-            fitted = fitting.fit_lut(table, target)
+            fitted = fitting.fit_lut(table, target, eevee_mode="EXACT")
             assert sum(c.cost for c in fitted.closures) <= fitting.BUDGET[target] + fitting.EXTRA_BUDGET[target]
-            lean = fitting.fit_lut(table, target, extra_budget=0)
+            lean = fitting.fit_lut(table, target, extra_budget=0, eevee_mode="EXACT")
             assert sum(c.cost for c in lean.closures) <= fitting.BUDGET[target]
+            if target == "EEVEE":  # a converged fit within its own budget
+                wide = fitting.fit_lut(table, target, eevee_mode="CONVERGED")
+                assert sum(c.cost for c in wide.closures) <= fitting.CONVERGED_BUDGET + fitting.CONVERGED_EXTRA
+                assert np.all(wide.weights >= 0)
             assert np.all(fitted.weights >= 0)
             for k, c in enumerate(fitted.closures):
                 assert fitted.weights[k].max() <= c.max_weight + 1e-12

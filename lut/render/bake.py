@@ -57,9 +57,9 @@ class RenderBake:
         return {target: fitting.reported_errors(fit.grams(), amps) for target, fit in self.fits.items()}
 
 
-def _cached_fit(path, lut, target, exact_metallic, calibration):
+def _cached_fit(path, lut, target, exact_metallic, calibration, eevee_mode="EXACT"):
     """The fit stored at ``path`` if it is valid and belongs to this LUT,
-    target and calibration, else None."""
+    target, calibration and EEVEE mode, else None."""
     if not pathlib.Path(path).exists():
         return None
     try:
@@ -68,7 +68,7 @@ def _cached_fit(path, lut, target, exact_metallic, calibration):
         return None
     if fitted.lut_key != lut.key or fitted.target != target or fitted.exact_metallic != exact_metallic:
         return None
-    if fitted.calibration != calibration:
+    if fitted.calibration != calibration or fitted.eevee_mode != eevee_mode:
         return None
     return fitted
 
@@ -90,6 +90,7 @@ def bake_for_render(
     targets=closures.TARGETS,
     exact_metallic=True,
     eevee_calibration=None,
+    eevee_mode=fitting.DEFAULT_EEVEE_MODE,
     force=False,
     progress=None,
     **lut_options,
@@ -99,10 +100,12 @@ def bake_for_render(
     valid cached files are reused unless ``force``.  ``eevee_calibration``:
     the Blender line whose measured EEVEE closure responses the EEVEE fit
     uses (``lut.render.eevee.calibration_for(bpy.app.version)``; None: Cycles'
-    formulas).  ``progress(fraction)``
+    formulas); ``eevee_mode``: "EXACT" or "CONVERGED"
+    (``lut.render.fitting.EEVEE_MODES``).  ``progress(fraction)``
     (0..1) is called throughout and may raise to cancel: files already
     complete stay (they are valid caches), nothing is half-written."""
     targets = [closures.validate_target(t) for t in targets]
+    eevee_mode = fitting.validate_eevee_mode(eevee_mode)
     report = progress or (lambda fraction: None)
     computed = []
     path = baking.lut_path(paint, directory, **lut_options)
@@ -119,8 +122,9 @@ def bake_for_render(
     fits, paths, todo = {}, {}, {}
     for target in targets:
         calibration = tuple(eevee_calibration) if (target == "EEVEE" and eevee_calibration) else None
-        paths[target] = fitting.fit_path(path, target, exact_metallic, calibration)
-        fitted = None if force else _cached_fit(paths[target], table, target, exact_metallic, calibration)
+        mode = eevee_mode if target == "EEVEE" else "EXACT"
+        paths[target] = fitting.fit_path(path, target, exact_metallic, calibration, mode)
+        fitted = None if force else _cached_fit(paths[target], table, target, exact_metallic, calibration, mode)
         if fitted is None:
             todo[target] = calibration
         else:
@@ -130,7 +134,14 @@ def bake_for_render(
     # reported (where a cancel is raised) on this thread.
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, len(todo))) as pool:
         futures = {
-            pool.submit(fitting.fit_lut, table, target, exact_metallic=exact_metallic, calibration=calibration): target
+            pool.submit(
+                fitting.fit_lut,
+                table,
+                target,
+                exact_metallic=exact_metallic,
+                calibration=calibration,
+                eevee_mode=eevee_mode if target == "EEVEE" else "EXACT",
+            ): target
             for target, calibration in todo.items()
         }
         try:

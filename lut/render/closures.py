@@ -436,7 +436,7 @@ def _lobes(type_dict, exact_metallic):
     return [Closure(grey, ior=n, roughness=r) for r in rough] + [Closure("glossy", roughness=r) for r in rough]
 
 
-def candidates(type_dict: dict, target: str = "CYCLES", exact_metallic: bool = True) -> list:
+def candidates(type_dict: dict, target: str = "CYCLES", exact_metallic: bool = True, converged: bool = False) -> list:
     """The closures a paint type may be fitted with on a render target:
     Lambert; for Cycles the Toon ramps (the subsurface terms' light-side
     fall-off and the single scattering's view dependence), retro Toon ramps
@@ -450,7 +450,8 @@ def candidates(type_dict: dict, target: str = "CYCLES", exact_metallic: bool = T
     diffuse closure as Lambert (``lut.render.eevee``): Lambert and the lobes; for
     a smooth type, whose mirror leaves one of EEVEE's two exact reflection
     closures free, retro GGX lobes (``retro_glossy``) for back-scattering
-    pigments."""
+    pigments; for a converged EEVEE fit (``converged``: closures beyond the
+    exact ones, averaged over samples) retro GGX lobes for every type."""
     target = validate_target(target)
     basis = [Closure("lambert")]
     if target == "CYCLES":
@@ -458,7 +459,7 @@ def candidates(type_dict: dict, target: str = "CYCLES", exact_metallic: bool = T
         basis += [Closure("oren_nayar", roughness=r) for r in (0.5, 1.0)]
         basis += [Closure("retro_toon", a, s) for a in (0.15, 0.3, 0.5) for s in (0.2, 0.6)]
     basis += _lobes(type_dict, exact_metallic)
-    if target == "EEVEE" and float(type_dict["slope"]) == 0:
+    if target == "EEVEE" and (converged or float(type_dict["slope"]) == 0):
         basis += [Closure("retro_glossy", roughness=r) for r in RETRO_ROUGHNESS]
     if target == "CYCLES" and float(type_dict["slope"]) > 0.3:
         basis += [Closure("sheen", roughness=r) for r in (0.3, 0.5, 0.8, 1.0)]

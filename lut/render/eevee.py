@@ -220,3 +220,171 @@ def is_reflection(closure: Closure) -> bool:
     """Whether EEVEE counts the closure as a reflection closure (its
     microfacet lobes) rather than a diffuse one (``EXACT_REFLECTION_CLOSURES``)."""
     return CLOSURE_KINDS[closure.kind].reflection
+
+
+def sums_exactly(closures, mirror: bool) -> bool:
+    """Whether EEVEE sums these closures exactly at one sample: at most
+    ``EXACT_REFLECTION_CLOSURES`` reflection closures (a smooth type's mirror
+    takes one) and diffuse closures of one normal (a retro Toon lobe's is the
+    view); beyond that ``closure_select`` picks one per bin at random."""
+    reflections = sum(is_reflection(c) for c in closures) + bool(mirror)
+    normals = {c.kind == "retro_toon" for c in closures if not is_reflection(c)}
+    return reflections <= EXACT_REFLECTION_CLOSURES and len(normals) <= 1
+
+
+#: Render samples of an EEVEE final render and of its viewport (Blender's
+#: defaults, ``scene.eevee.taa_render_samples`` and ``taa_samples``).
+RENDER_SAMPLES = 64
+VIEWPORT_SAMPLES = 16
+#: ``samples_needed``: a render has converged where its per-pixel spread
+#: is below the fit's own error at that colour (more samples no longer
+#: bring its pixels nearer the model), and below this at least.
+NOISE_FLOOR = 0.02
+#: How the spread falls with samples: as N^-CONVERGENCE.  EEVEE's sample
+#: sequence is stratified, faster than independent samples' N^-0.5:
+#: measured on a flat plane (``scripts/eevee_converged.py --noise``) the
+#: spread fell 6-9 fold from 1 to 16 samples and 18-20 fold to 64.
+CONVERGENCE = 0.7
+
+
+def _colours(weights, cos_view, amplitudes, theta_v):
+    """Σ_c a_c·w_kc: each closure's colour (K, N, 3) at views θv (N,) as
+    the node group reads its weights."""
+    from .fitting import texture_weights
+
+    w = texture_weights(weights, cos_view, np.cos(theta_v))  # (K, C, N, T)
+    amps = np.asarray(amplitudes, dtype=float)  # (3 channels, C)
+    if w.shape[-1] == 1:
+        return np.einsum("kcn,hc->knh", w[..., 0], amps)
+    return np.einsum("kcnh,hc->knh", w, amps)
+
+
+def _selection(closures, colours, facet, mirror_n, values):
+    """Per closure the contribution C_k (K', N, 3) EEVEE's mean renders and
+    the weight s_k (K', N) ``closure_select`` picks it by (the closure's
+    weight times the mean of its colour), a smooth type's mirror last
+    (``mirror_n``, its IOR, or None: no contribution off its delta, but a
+    share of its bin).  A grey lobe is a Mix Shader factor (clamped to
+    [0, 1]) times a lobe whose colour is taken as its Fresnel factor at
+    normal incidence."""
+    contributions, weights = [], []
+    for k, closure in enumerate(closures):
+        if closure.grey:
+            factor = np.clip(colours[k].mean(axis=-1), 0.0, 1.0)
+            contributions.append((factor * values[k])[:, None] * np.ones(3))
+            weights.append(factor * ((closure.ior - 1.0) / (closure.ior + 1.0)) ** 2)
+        else:
+            contributions.append(colours[k] * values[k][:, None])
+            weights.append(np.abs(colours[k]).mean(axis=-1))
+    n_points = values.shape[1]
+    if mirror_n is not None:
+        contributions.append(np.zeros((n_points, 3)))
+        weights.append(np.full(n_points, facet * ((mirror_n - 1.0) / (mirror_n + 1.0)) ** 2))
+    return np.array(contributions).reshape(-1, n_points, 3), np.array(weights).reshape(-1, n_points)
+
+
+def bins(closures, mirror: bool) -> list:
+    """The closure bin each closure (and a smooth type's mirror, last) falls
+    in: 0 the diffuse one; reflection closures alternate between bins 2
+    and 1 in the order the node group sums them (EEVEE's
+    ``CHOOSE_MIN_WEIGHT_CLOSURE_BIN``)."""
+    out, nth = [], 0
+    for reflection in [is_reflection(c) for c in closures] + ([True] if mirror else []):
+        if reflection:
+            out.append(2 - nth % 2)
+            nth += 1
+        else:
+            out.append(0)
+    return out
+
+
+def spread_of(closures, weights, cos_view, mirror, n, amplitudes, points, version, samples=1, values=None):
+    """``spread`` of closures with weights (K, C, M, T) at view cosines
+    ``cos_view``; ``n``: the type's IOR (its mirror's), ``version``: the
+    calibrated Blender line (None: Cycles' formulas); ``values``: the
+    closures' responses at ``points`` (K, N), when computed already."""
+    if sums_exactly(closures, mirror):
+        return 0.0
+    theta_l, theta_v, phi = (np.asarray(a, dtype=float).ravel() for a in points)
+    if values is None:
+        values = np.array([evaluate_closure(c, theta_l, theta_v, phi, version) for c in closures])
+    values = np.asarray(values, dtype=float).reshape(len(closures), theta_l.size)
+    colours = _colours(weights, cos_view, amplitudes, theta_v)
+    facet = float(np.mean(np.asarray(amplitudes, dtype=float)[:, 0]))
+    contributions, select = _selection(closures, colours, facet, n if mirror else None, values)
+    which = np.array(bins(closures, mirror))
+    variance = np.zeros((theta_l.size, 3))
+    for b in np.unique(which):
+        c, s = contributions[which == b], select[which == b]
+        total = s.sum(axis=0)
+        p = s / np.where(total > 0, total, 1.0)
+        inverse = np.where(p > 0, 1.0 / np.where(p > 0, p, 1.0), 0.0)
+        variance += np.maximum(np.sum(c**2 * inverse[..., None], axis=0) - c.sum(axis=0) ** 2, 0.0)
+    den = float(np.sum(contributions.sum(axis=0) ** 2))
+    if den <= 0:
+        return 0.0
+    return float(np.sqrt(variance.sum() / den) / max(int(samples), 1) ** CONVERGENCE)
+
+
+def spread(fit, amplitudes, samples=1, points=None):
+    """The per-pixel spread of EEVEE's render of a fit at a colour
+    (``amplitudes``, ``Paint.amplitudes``) at ``samples`` samples:
+    sqrt(Σ variance / Σ L²) over RGB and the fidelity measure's geometries
+    (``points``: (θl, θv, φ) arrays; default the measure's own), formed as
+    the measure itself is.
+
+    Per pixel and sample EEVEE keeps one closure per bin (``bins``),
+    closure k with probability p_k = s_k/Σs (``_selection``) and scaled by
+    1/p_k, so a bin's estimate X has mean Σ C_k and variance
+    Σ C_k²/p_k - (Σ C_k)²; the bins' variances are added (their shared
+    random number ignored), and fall with samples as N^-CONVERGENCE.  0
+    for a fit EEVEE sums exactly.  Checked against renders of a flat plane
+    at one sample: 168% predicted where 169% was measured, 5-12% where
+    3-9% were."""
+    if fit.target != "EEVEE":
+        return 0.0
+    from . import measure
+
+    points = measure.points(fit.mirror) if points is None else points
+    version = tuple(fit.calibration) if fit.calibration else None
+    return spread_of(fit.closures, fit.weights, fit.cos_view, fit.mirror, fit.n, amplitudes, points, version, samples)
+
+
+def evaluate_closure(closure, theta_l, theta_v, phi, version):
+    """EEVEE's response of a closure where calibrated (``evaluate``), else
+    Cycles' formula (an uncalibrated Blender line)."""
+    if version is not None:
+        return evaluate(closure, theta_l, theta_v, phi, version)
+    return closure.evaluate(theta_l, theta_v, phi)
+
+
+def samples_needed(fit, amplitudes, bound=None, most=4096) -> int:
+    """The fewest EEVEE samples (a power of two) at which a fit's per-pixel
+    spread (``spread``) at a colour is within ``bound`` (default: the fit's
+    error at that colour, ``NOISE_FLOOR`` at least): 1 for a fit EEVEE sums
+    exactly; ``most`` at most."""
+    if bound is None:
+        bound = max(fit.error(amplitudes), NOISE_FLOOR)
+    return samples_for(spread(fit, amplitudes), bound, most)
+
+
+def samples_for(one: float, bound: float, most=4096) -> int:
+    """The fewest samples (a power of two, ``most`` at most) at which a
+    spread of ``one`` at one sample falls within ``bound``."""
+    samples = 1
+    while one / samples**CONVERGENCE > bound and samples < most:
+        samples *= 2
+    return samples
+
+
+def type_spread(fit) -> float:
+    """The spread at one sample (``spread``) of a type's noisiest colour:
+    the largest over the colours of one component alone."""
+    if fit.target != "EEVEE" or fit.sums_exactly:
+        return 0.0
+    out = 0.0
+    for c in range(fit.weights.shape[1]):
+        amps = np.zeros((3, fit.weights.shape[1]))
+        amps[:, c] = 1.0
+        out = max(out, spread(fit, amps))
+    return out

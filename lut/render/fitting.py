@@ -82,6 +82,26 @@ BUDGET = {"CYCLES": 8, "EEVEE": 3}
 #: rough facets, strongly back-scattering pigments) pay the render cost.
 EXTRA_BUDGET = {"CYCLES": 4, "EEVEE": 0}
 
+#: How an EEVEE fit is drawn (``validate_eevee_mode``).  EEVEE keeps one
+#: closure per bin (one diffuse, two reflection) in each pixel and sample,
+#: picked at random in proportion to its weight and rescaled so that the
+#: mean over samples is the closures' sum (``closure_select`` in EEVEE's
+#: GLSL).  "EXACT": at most the closures EEVEE sums exactly at one sample
+#: (``BUDGET["EEVEE"]``); "CONVERGED": where that misses a goal of the
+#: measure, up to ``CONVERGED_BUDGET`` closures (+ ``CONVERGED_EXTRA``),
+#: exact once samples average them (``lut.render.eevee.noise`` says how
+#: many it takes).  A type whose exact fit meets its goals keeps it in
+#: either mode: it renders noise-free at one sample.
+EEVEE_MODES = ("EXACT", "CONVERGED")
+#: The mode a bake fits EEVEE in unless told otherwise (final renders take
+#: ``eevee.RENDER_SAMPLES`` samples, the viewport ``eevee.VIEWPORT_SAMPLES``).
+DEFAULT_EEVEE_MODE = "CONVERGED"
+CONVERGED_BUDGET = 8
+CONVERGED_EXTRA = 4
+#: A converged fit is kept where it brings the fit this much nearer its
+#: goals (its ``shortfall``) than the exact one: noise for less is no gain.
+CONVERGED_GAIN = 0.8
+
 #: Views the weights are fitted at, and the light grid of each view.
 VIEWS = 24
 #: Columns of the weights texture: the fitted weights, linear in cos θv
@@ -145,6 +165,13 @@ DEFAULT_ROW_SETS = ("hemisphere", "grazing")
 GRAZING_EMPHASIS = 2.0
 
 
+def validate_eevee_mode(mode: str) -> str:
+    """``mode`` if it is one of ``EEVEE_MODES``; a clear error otherwise."""
+    if mode not in EEVEE_MODES:
+        raise ValueError(f"eevee_mode must be one of {', '.join(EEVEE_MODES)}, got {mode!r}")
+    return mode
+
+
 def validate_row_set(row_set: str) -> str:
     if row_set not in ROW_SETS:
         raise ValueError(f"row_sets must be some of {', '.join(ROW_SETS)}, got {row_set!r}")
@@ -182,6 +209,18 @@ class Fit:
     calibration: tuple | None = None
     grazing_residual: np.ndarray | None = None
     grazing_reference: np.ndarray | None = None
+    eevee_mode: str = "EXACT"
+
+    @property
+    def sums_exactly(self) -> bool:
+        """Whether EEVEE draws these closures exactly at one sample: at most
+        one diffuse normal and two reflection closures (a smooth type's
+        mirror is one of them); Cycles always does."""
+        if self.target != "EEVEE":
+            return True
+        from . import eevee
+
+        return eevee.sums_exactly(self.closures, self.mirror)
 
     @property
     def rough(self) -> bool:
@@ -243,6 +282,7 @@ class Fit:
             **self.grams(),
             "lut_key": self.lut_key,
             "calibration": list(self.calibration) if self.calibration else None,
+            "eevee_mode": self.eevee_mode,
         }
 
 
@@ -581,6 +621,9 @@ def fit_lut(
     grid=LIGHT_GRID,
     calibration=None,
     row_sets=DEFAULT_ROW_SETS,
+    eevee_mode=DEFAULT_EEVEE_MODE,
+    converged_budget=CONVERGED_BUDGET,
+    converged_extra=CONVERGED_EXTRA,
 ) -> Fit:
     """Fit a loaded LUT (``lut.lutfiles.baking.LUT``) onto the closures of a render
     target (module docstring).  ``budget``, ``extra_budget``: closures per
@@ -589,8 +632,13 @@ def fit_lut(
     Blender line whose measured closure responses to fit with (``lut.render.eevee``;
     None: Cycles' formulas, EEVEE's own rendering unmodelled).  ``row_sets``:
     the rows to fit on, tried in turn (``ROW_SETS``) until a fit meets its
-    goals; the fit kept is the one nearest them (``shortfall``)."""
+    goals; the fit kept is the one nearest them (``shortfall``).
+    ``eevee_mode``: for EEVEE, "EXACT" or "CONVERGED" (``EEVEE_MODES``):
+    where the exact fit misses a goal, a converged one of up to
+    ``converged_budget`` closures (+ ``converged_extra``) is fitted too and
+    the one nearer the goals kept."""
     target = closures.validate_target(target)
+    eevee_mode = validate_eevee_mode(eevee_mode) if target == "EEVEE" else "EXACT"
     evaluate = evaluator_for(target, calibration)
     budget = BUDGET[target] if budget is None else int(budget)
     if budget < 1:
@@ -611,13 +659,38 @@ def fit_lut(
     theta_v = np.arccos(np.clip(cos_view, np.cos(MAX_VIEW), 1.0))
     model = model_radiance(lut)
     best = None
+    exact = target == "EEVEE"
     for row_set in row_sets:
         theta_l, phi, row_w = _rows(row_set, theta_v, grid)
-        fitted = _fit_rows(lut, target, evaluate, basis, theta_v, theta_l, phi, row_w, model, budget, extra_budget)
+        fitted = _fit_rows(
+            lut, target, evaluate, basis, theta_v, theta_l, phi, row_w, model, budget, extra_budget, exact
+        )  # fmt: skip
         if best is None or fitted[-1] < best[-1]:
             best = fitted
         if best[-1] <= 1.0:  # every colour of the type meets both goals: the next sets need not be tried
             break
+    if eevee_mode == "CONVERGED" and best[-1] > 1.0:
+        # Past EEVEE's exact bins: more closures, averaged over samples,
+        # kept where they bring the fit nearer its goals by CONVERGED_GAIN.
+        wide = closures.candidates(type_dict, target, metallic, converged=True)
+        noise = functools.partial(
+            _viewport_spread,
+            points=model[0],
+            mirror=float(type_dict["slope"]) == 0.0,
+            n=reference_index(type_dict["n"]),
+            cos_view=cos_view,
+            calibration=calibration,
+        )
+        for row_set in row_sets:
+            theta_l, phi, row_w = _rows(row_set, theta_v, grid)
+            fitted = _fit_rows(
+                lut, target, evaluate, wide, theta_v, theta_l, phi, row_w, model,
+                int(converged_budget), int(converged_extra), False, noise,
+            )  # fmt: skip
+            if fitted[-1] < CONVERGED_GAIN * best[-1]:
+                best = fitted
+            if best[-1] <= 1.0:
+                break
     basis_kept, weights, whole, band, _ = best
     n = reference_index(type_dict["n"])
     dense = view_cosines(texture_views(views))
@@ -637,17 +710,44 @@ def fit_lut(
         calibration=tuple(calibration) if (calibration is not None and target == "EEVEE") else None,
         grazing_residual=band[0],
         grazing_reference=band[1],
+        eevee_mode=eevee_mode,
     )
 
 
-def shortfall(whole, band, goals) -> float:
+def _viewport_spread(kept, weights, values, *, points, mirror, n, cos_view, calibration):
+    """{component: per-pixel spread (``eevee.spread_of``) of EEVEE's render
+    of closures ``kept`` with ``weights`` at ``eevee.VIEWPORT_SAMPLES``} for
+    the colour of that component alone (a black paint is all facet), on the
+    measure's geometries ``points``, where the closures' responses are
+    ``values``."""
+    from . import eevee
+
+    version = tuple(calibration) if calibration is not None else None
+    spreads = []
+    for c in range(len(COMPONENTS)):
+        amps = np.zeros((3, len(COMPONENTS)))
+        amps[:, c] = 1.0
+        spreads.append(
+            eevee.spread_of(kept, weights, cos_view, mirror, n, amps, points, version, eevee.VIEWPORT_SAMPLES, values)
+        )
+    return dict(zip(COMPONENTS, spreads, strict=True))
+
+
+def shortfall(whole, band, goals, spreads=None) -> float:
     """How far a fit is from its goals: the largest ratio of a component's
     error to its goal, over the whole measure and its grazing band (the
     error of the type's worst colour, where that component dominates);
-    below 1 every colour of the type meets both goals."""
-    ratios = [e / goals[0] for e in component_errors(*whole).values() if e is not None]
-    ratios += [e / goals[1] for e in component_errors(*band).values() if e is not None]
-    return max(ratios, default=0.0)
+    below 1 every colour of the type meets both goals.  ``spreads``
+    ({component: per-pixel spread}, ``_viewport_spread``): each error is
+    then a pixel's whole deviation from the model, sqrt(error² + spread²)."""
+    spreads = spreads or {}
+
+    def ratios(grams, goal):
+        return [
+            np.hypot(e, spreads.get(name, 0.0)) / goal for name, e in component_errors(*grams).items() if e is not None
+        ]
+
+    return max(ratios(whole, goals[0]) + ratios(band, goals[1]), default=0.0)
 
 
 def _rows(row_set, theta_v, grid):
@@ -662,8 +762,15 @@ def _rows(row_set, theta_v, grid):
     return tuple(np.concatenate([x, y], axis=1) for x, y in zip(rows, lattice, strict=True))
 
 
-def _fit_rows(lut, target, evaluate, basis, theta_v, theta_l, phi, row_w, model, budget, extra_budget):
-    """Select closures and fit their weights on the given rows; returns
+def _fit_rows(
+    lut, target, evaluate, basis, theta_v, theta_l, phi, row_w, model, budget, extra_budget, exact, noise=None
+):
+    """Select closures and fit their weights on the given rows (``exact``:
+    within the closures EEVEE sums exactly at one sample; ``noise``: for a
+    converged EEVEE fit, the spread of closures and weights at the
+    viewport's samples, ``_viewport_spread``: the selection's first n
+    closures nearest the goals whose spread is within
+    ``eevee.NOISE_BOUND`` are kept); returns
     (closures kept, weights (K, C, M, T), the measure's whole and grazing
     Gram matrices, the worst component's error on the measure)."""
     type_dict = lut.meta["type"]
@@ -688,7 +795,7 @@ def _fit_rows(lut, target, evaluate, basis, theta_v, theta_l, phi, row_w, model,
     target_error = TARGET_ERROR[target]["smooth" if mirror else "rough"]
     goal = 0.25 * target_error
     caps = None
-    if target == "EEVEE":
+    if exact:
         from . import eevee
 
         # EEVEE sums one diffuse normal and two reflection closures exactly
@@ -696,9 +803,10 @@ def _fit_rows(lut, target, evaluate, basis, theta_v, theta_l, phi, row_w, model,
         # smooth type's mirror is one of the two.
         caps = (np.array([eevee.is_reflection(c) for c in basis]), eevee.EXACT_REFLECTION_CLOSURES - mirror)
 
-    def weights_of(chosen):
+    def weights_of(chosen, response=evaluate):
         """NNLS weights of the chosen closures, the kept closures and their
-        measure's Gram matrices (whole, grazing band)."""
+        measure's Gram matrices (whole, grazing band; each closure's
+        response at the measure's geometries from ``response``)."""
         weights = np.zeros((len(chosen), c_, m_, t_))
         for p in range(t_ * c_):
             idx = [i for i, k in enumerate(chosen) if allowed[p, k]]
@@ -712,13 +820,33 @@ def _fit_rows(lut, target, evaluate, basis, theta_v, theta_l, phi, row_w, model,
             weights[g] = weights[g].mean(axis=-1, keepdims=True)
         keep = [i for i in range(len(chosen)) if weights[i].max() > 0]
         kept = [basis[chosen[i]] for i in keep]
-        return kept, weights[keep], *measure_grams(model, kept, cos_view, weights[keep], evaluate)
+        return kept, weights[keep], *measure_grams(model, kept, cos_view, weights[keep], response)
 
     goals = measure.goals(target, mirror)
 
     def score(whole, band):
         return shortfall(whole, band, goals)
 
+    if noise is not None:
+        # Each closure past EEVEE's exact ones makes the render noisier: of
+        # the selection's steps, keep the one whose pixels at the viewport's
+        # samples are nearest the model (bias and spread together).
+        chosen, _ = _select(gram, rhs, norm, allowed, upper, cost, budget + extra_budget, goal**2, caps)
+        (tl, tv, ph), _ = model
+        values = {}  # each chosen closure's response at the measure's geometries, computed once
+
+        def cached(closure, *_):
+            if closure not in values:
+                values[closure] = evaluate(closure, tl, tv, ph)
+            return values[closure]
+
+        best = None
+        for n in range(1, len(chosen) + 1):
+            fitted = weights_of(chosen[:n], cached)
+            noisy = shortfall(*fitted[2:], goals, noise(*fitted[:2], [values[c] for c in fitted[0]]))
+            if best is None or noisy < best[-1]:
+                best = (*fitted, noisy)
+        return best
     chosen, shared = _select(gram, rhs, norm, allowed, upper, cost, budget, goal**2, caps)
     basis_kept, weights, whole, band = weights_of(chosen)
     if extra_budget > 0 and score(whole, band) > 1.0:
@@ -737,15 +865,20 @@ def _fit_rows(lut, target, evaluate, basis, theta_v, theta_l, phi, row_w, model,
 # ---------------------------------------------------------------------- files
 
 
-def fit_path(lut_path, target="CYCLES", exact_metallic=True, calibration=None) -> pathlib.Path:
+def fit_path(
+    lut_path, target="CYCLES", exact_metallic=True, calibration=None, eevee_mode=DEFAULT_EEVEE_MODE
+) -> pathlib.Path:
     """The weights file of a target beside its LUT:
     ``paintfit-cycles-f<FIT_VERSION>-<key>.exr`` (``paintfit-cycles4-…`` for
     Blender 4.2-4.5's lobes), ``paintfit-eevee-…`` (``paintfit-eevee50-…``
-    when fitted with Blender 5.0's measured EEVEE responses)."""
+    when fitted with Blender 5.0's measured EEVEE responses; a converged
+    EEVEE fit ends its name with ``c``: ``paintfit-eevee50c-…``)."""
     lut_path = pathlib.Path(lut_path)
     name = closures.validate_target(target).lower() + ("" if exact_metallic else "4")
     if target == "EEVEE" and calibration is not None:
         name += "".join(str(int(v)) for v in calibration[:2])
+    if target == "EEVEE" and validate_eevee_mode(eevee_mode) == "CONVERGED":
+        name += "c"
     return lut_path.with_name(lut_path.name.replace("paintlut-", f"paintfit-{name}-f{FIT_VERSION}-"))
 
 
@@ -805,6 +938,7 @@ def read_fit(path) -> Fit:
             calibration=tuple(h["calibration"]) if h.get("calibration") else None,
             grazing_residual=np.array(h["grazing_residual"], dtype=float),
             grazing_reference=np.array(h["grazing_reference"], dtype=float),
+            eevee_mode=validate_eevee_mode(h.get("eevee_mode", "EXACT")),
         )
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         if isinstance(exc, lutfile.LUTError):
