@@ -56,6 +56,12 @@ class FitError(typing.NamedTuple):
     target: float
     grazing: float
     grazing_target: float
+    #: EEVEE: "EXACT" or "CONVERGED" (the scene's mode the fit was made in),
+    #: whether EEVEE sums the fit's closures exactly at one sample, and the
+    #: samples its noisiest colour needs to converge (``lut.render.eevee.samples_for``).
+    eevee_mode: str = ""
+    exact: bool = True
+    samples: int = 1
 
     @property
     def missed(self) -> bool:
@@ -112,6 +118,16 @@ def eevee_calibration():
     return eevee.calibration_for(bpy.app.version)
 
 
+def eevee_mode(scene=None) -> str:
+    """How the scene's EEVEE draws paint materials (its Paint LUT setting,
+    ``lut.render.fitting.EEVEE_MODES``): "CONVERGED" (the default; more
+    closures where the three EEVEE sums exactly miss a goal, averaged over
+    samples) or "EXACT" (at most those three: exact at one sample)."""
+    scene = scene if scene is not None else getattr(bpy.context, "scene", None)
+    settings = getattr(scene, "paint_lut", None) if scene is not None else None
+    return settings.eevee_mode if settings is not None else fitting.DEFAULT_EEVEE_MODE
+
+
 def store_result(material, paint: lut.Paint, result: render_bake.RenderBake, exact_metallic=None, clear_stale=True):
     """Record a finished bake on the material (LUT path relative to the
     .blend when it is saved), build or reuse its type's node groups (one per
@@ -133,8 +149,15 @@ def store_result(material, paint: lut.Paint, result: render_bake.RenderBake, exa
     settings.diffuse_albedo = render_bake.diffuse_albedo(result.lut)
     nodes.build_seen_group(result.fits[next(iter(result.fits))], settings.diffuse_albedo)
     settings.fits = json.dumps(
-        {target: {**f.grams(), "goal": f.target_error, "goals": list(f.goals)} for target, f in result.fits.items()}
-    )
+        {
+            target: {
+                **f.grams(), "goal": f.target_error, "goals": list(f.goals),
+                **({"eevee_mode": f.eevee_mode, "exact": f.sums_exactly, "spread": eevee.type_spread(f)}
+                   if target == "EEVEE" else {}),
+            }
+            for target, f in result.fits.items()
+        }
+    )  # fmt: skip
     export.update_fallback(material, paint)
     if clear_stale:
         settings.stale = False
@@ -151,7 +174,7 @@ def bake_material(material, *, directory=None, force=False, exact_metallic=None,
     paint = paint_of(material)
     result = render_bake.bake_for_render(
         paint, directory or lut_directory(), targets=engine_targets(), exact_metallic=exact,
-        eevee_calibration=eevee_calibration(), force=force, progress=progress, **options,
+        eevee_calibration=eevee_calibration(), eevee_mode=eevee_mode(), force=force, progress=progress, **options,
     )  # fmt: skip
     store_result(material, paint, result, exact)
     material.paint_lut.enabled = True
@@ -194,7 +217,14 @@ def fit_errors(material) -> dict:
         whole, grazing = fitting.reported_errors(f, amps)
         kind = measure.goals(target, paint.slope == 0)  # an earlier release stored the whole goal alone
         goals = f.get("goals") or (f.get("goal", kind[0]), kind[1])
-        out[target] = FitError(whole, float(goals[0]), grazing, float(goals[1]))
+        noise = {}
+        if target == "EEVEE":
+            bound = max(whole, eevee.NOISE_FLOOR)
+            noise = {
+                "eevee_mode": f.get("eevee_mode", "EXACT"), "exact": bool(f.get("exact", True)),
+                "samples": eevee.samples_for(float(f.get("spread", 0.0)), bound),
+            }  # fmt: skip
+        out[target] = FitError(whole, float(goals[0]), grazing, float(goals[1]), **noise)
     return out
 
 
@@ -348,7 +378,7 @@ def is_current(material, paint, *, directory=None, exact_metallic=None, **option
         if not path.stem.endswith(table.key[:24]):  # another type's LUT renamed onto this one's name
             return False
         for target in engine_targets():
-            fit_file = lut.render.fitting.fit_path(path, target, exact, eevee_calibration())
+            fit_file = lut.render.fitting.fit_path(path, target, exact, eevee_calibration(), eevee_mode())
             fitted = lut.render.fitting.read_fit(fit_file)
             if fitted.lut_key != table.key or fitted.target != target:
                 return False

@@ -162,7 +162,8 @@ def linked_status(material, exact_metallic=None) -> dict:
             table = lut.load_lut(path)
             exact = nodes.exact_metallic_default(exact_metallic)
             for target in closures.TARGETS:
-                fitted = fitting.read_fit(fitting.fit_path(path, target, exact, api.eevee_calibration()))
+                fit_file = fitting.fit_path(path, target, exact, api.eevee_calibration(), api.eevee_mode())
+                fitted = fitting.read_fit(fit_file)
                 baked_node = nodes.group_of(material, target)
                 if fitted.lut_key != table.key or baked_node is None or not nodes.is_paint_group(baked_node.node_tree):
                     raise lut.LUTError("not wired to this bake")
@@ -200,7 +201,8 @@ def bake_one(material, used, force=False, rewire=False, **options) -> dict:
 def _fit_entry(material) -> dict:
     """The paint type's LUT key (materials with one key shared one bake) and
     each engine's fit error at the material's colours (the fidelity measure,
-    whole and over the grazing band), with their targets."""
+    whole and over the grazing band), with their targets; for EEVEE also
+    how it draws the material (``api.FitError``)."""
     entry = {"type": pathlib.Path(material.paint_lut.lut_path).stem.removeprefix("paintlut-")}
     errors = api.fit_errors(material)
     entry["fit"] = {
@@ -209,6 +211,9 @@ def _fit_entry(material) -> dict:
             "target": f.target,
             "grazing": round(f.grazing, 5),
             "grazing_target": f.grazing_target,
+            # How EEVEE draws it: the scene's mode, whether at one sample
+            # exactly, and the samples its noisiest colour needs.
+            **({"mode": f.eevee_mode, "exact_at_one_sample": f.exact, "samples": f.samples} if f.eevee_mode else {}),
         }
         for t, f in errors.items()
     }
@@ -258,7 +263,7 @@ def scan_file(path, store=None) -> dict:
     """The paint types a .blend file's used materials need (the farm's
     first phase, ``lut.farm``): its report entry {"file", "status":
     "scanned" (or "failed" with its "reason"), "paint_types": [{"key", "store",
-    "paint", "exact_metallic", "eevee_calibration", "materials"}]}, one per
+    "paint", "exact_metallic", "eevee_calibration", "eevee_mode", "materials"}]}, one per
     type and folder, a type's paint being its first material's.  A material
     whose paint is invalid is left to the bake, which reports it."""
     path = pathlib.Path(path).resolve()
@@ -285,6 +290,7 @@ def scan_file(path, store=None) -> dict:
                 "paint": paint.to_dict(),
                 "exact_metallic": nodes.exact_metallic_default(None),
                 "eevee_calibration": list(calibration) if calibration else None,
+                "eevee_mode": api.eevee_mode(),
                 "materials": [],
             },
         )

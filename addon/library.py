@@ -177,7 +177,7 @@ def _start_next():
             continue
         job = jobs.BakeJob(
             paint, api.lut_directory(), exact_metallic=nodes.EXACT_METALLIC, targets=api.engine_targets(),
-            eevee_calibration=api.eevee_calibration(),
+            eevee_calibration=api.eevee_calibration(), eevee_mode=api.eevee_mode(),
         ).start()  # fmt: skip
         _jobs[material.name] = (job, paint, material.paint_lut.type_key())
         return

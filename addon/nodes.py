@@ -151,6 +151,8 @@ def build_group(fit: fitting.Fit, weights_path, exact_metallic=None):
         old.name = f"{name} (old)"  # materials that use it keep it until rewired
     group = bpy.data.node_groups.new(name, "ShaderNodeTree")
     group["paint_lut_fit"] = fit_id
+    if fit.target == "EEVEE":
+        group["paint_lut_eevee_mode"] = fit.eevee_mode
     if hasattr(group, "description"):
         group.description = (
             "Paint LUT: a paint type (Germer's paint models) rendered as per-view weighted closures. "

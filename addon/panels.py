@@ -8,7 +8,7 @@ from . import api
 from .properties import MATERIAL_FIELDS, seen_limit
 
 
-def draw_settings(layout, material):
+def draw_settings(layout, material, scene=None):
     settings = material.paint_lut
     layout.prop(settings, "enabled")
     layout.prop(settings, "preset")
@@ -35,6 +35,23 @@ def draw_settings(layout, material):
         layout.label(text=bpy.path.basename(settings.lut_path), icon="CHECKMARK")
         for target, fit in api.fit_errors(material).items():
             layout.label(text=fit_error_text(target, fit), icon="ERROR" if fit.missed else "CHECKMARK")
+            if target == "EEVEE" and fit.eevee_mode:
+                layout.label(text=eevee_text(fit, api.eevee_mode(scene)), icon="INFO")
+    if scene is not None and getattr(scene, "paint_lut", None) is not None:
+        layout.prop(scene.paint_lut, "eevee_mode", text="EEVEE (scene)")
+
+
+def eevee_text(fit, scene_mode: str) -> str:
+    """The panel's EEVEE line for an ``api.FitError``: how EEVEE draws the
+    material (exactly at one sample, or converged over N samples), and a
+    note when the scene asks for the other mode (it applies at the next bake)."""
+    if fit.exact:
+        text = "EEVEE: exact at 1 sample"
+    else:
+        text = f"EEVEE: converged, about {fit.samples} samples (Render Samples in the scene)"
+    if scene_mode != fit.eevee_mode:
+        text += f"; the scene asks {scene_mode.title()}: bake to apply"
+    return text
 
 
 def seen_limit_text(limit: float) -> str:
@@ -55,7 +72,7 @@ class _PaintLUTPanel:
     bl_label = "Paint LUT"
 
     def draw(self, context):
-        draw_settings(self.layout, context.material)
+        draw_settings(self.layout, context.material, context.scene)
 
 
 class MATERIAL_PT_paint_lut(_PaintLUTPanel, bpy.types.Panel):

@@ -19,7 +19,7 @@ import sys
 import bpy
 
 from . import live
-from ._lut import lut, schema
+from ._lut import fitting, lut, schema
 from .live import working_space
 
 #: The paint fields a material stores (in ``lut.Paint``'s order).
@@ -275,16 +275,39 @@ def _add_paint_fields(cls):
 
 _add_paint_fields(PaintLUTSettings)
 
-CLASSES = (PaintLUTSettings,)
+
+class PaintLUTSceneSettings(bpy.types.PropertyGroup):
+    """A scene's Paint LUT settings: how its EEVEE draws paint materials
+    (``lut.render.fitting.EEVEE_MODES``).  A change applies at the next bake
+    (the panel says so; a bake computes only the EEVEE fits it lacks)."""
+
+    eevee_mode: bpy.props.EnumProperty(
+        name="EEVEE",
+        description="How EEVEE draws paint materials; applies at the next bake",
+        items=[
+            (
+                "CONVERGED", "Converged",
+                "More closures where three miss the goal: exact once samples average them "
+                "(final renders; the viewport converges as it accumulates samples)",
+            ),
+            ("EXACT", "Exact at 1 sample", "At most the three closures EEVEE sums exactly: no noise at one sample"),
+        ],
+        default=fitting.DEFAULT_EEVEE_MODE,
+    )  # fmt: skip
+
+
+CLASSES = (PaintLUTSettings, PaintLUTSceneSettings)
 
 
 def register():
     for cls in CLASSES:
         bpy.utils.register_class(cls)
     bpy.types.Material.paint_lut = bpy.props.PointerProperty(type=PaintLUTSettings)
+    bpy.types.Scene.paint_lut = bpy.props.PointerProperty(type=PaintLUTSceneSettings)
 
 
 def unregister():
+    del bpy.types.Scene.paint_lut
     del bpy.types.Material.paint_lut
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)

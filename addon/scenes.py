@@ -207,7 +207,10 @@ class Oracle:
         direction when θv = θl); equals f·E·cos θl."""
         # Light travels towards -ω_l with ω_l = (-sin θl, 0, cos θl), i.e. the
         # model's source at azimuth π; the sun points along -Z rotated about Y.
-        return self.image(theta_l, theta_v, phi)[RESOLUTION // 2, RESOLUTION // 2]
+        # Every pixel sees these directions: their mean is the render's mean
+        # over samples where EEVEE picks closures at random per pixel (a
+        # converged fit), and any one pixel where it does not.
+        return self.image(theta_l, theta_v, phi).mean(axis=(0, 1))
 
     def brdf(self, theta_l, theta_v, phi):
         """The rendered BRDF: radiance / (E cos θl)."""

@@ -607,7 +607,7 @@ class _Layout:
         self.props = []
         self.labels = []
 
-    def prop(self, data, name):
+    def prop(self, data, name, **_):
         assert name in data.bl_rna.properties, name
         self.props.append(name)
 
@@ -702,3 +702,47 @@ def test_a_save_copy_of_an_unsaved_file_leaves_the_session_as_it_was(fresh_file,
     assert api.is_current(material, api.paint_of(material), directory=api.user_lut_directory())
     bpy.ops.wm.open_mainfile(filepath=str(copy))
     assert bpy.data.materials["copied paint"].paint_lut.lut_path.startswith("//paint_lut/paintlut-")
+
+
+def test_the_scenes_eevee_mode_picks_the_eevee_fit_and_the_panel_and_report_say_which(material, lut_dir):
+    """Converged (the default) gives a sharp exponential paint, which
+    EEVEE's three exact closures draw 20-25% off the model, its converged
+    fit, with the samples it needs; switched to Exact, the material is no
+    longer current, the panel says a bake applies it, and the bake computes
+    the EEVEE fit alone."""
+    from addon import api, batch, nodes, panels
+    from lut import bench
+
+    scene = bpy.context.scene
+    assert scene.paint_lut.eevee_mode == "CONVERGED" == api.eevee_mode()
+    paint = next(p for _, p in bench.random_paints(24) if p.distribution == "exponential" and 0 < p.slope < 0.15)
+    api.set_paint(material, paint)
+    api.bake_material(material, directory=lut_dir)
+    assert nodes.group_of(material, "EEVEE").node_tree["paint_lut_eevee_mode"] == "CONVERGED"
+    fit = api.fit_errors(material)["EEVEE"]
+    assert fit.eevee_mode == "CONVERGED" and not fit.exact and 4 <= fit.samples <= 256
+    layout = _Layout()
+    panels.draw_settings(layout, material, scene)
+    assert f"EEVEE: converged, about {fit.samples} samples (Render Samples in the scene)" in [
+        t for t, _ in layout.labels
+    ]
+    assert "eevee_mode" in layout.props
+    assert api.is_current(material, api.paint_of(material), directory=lut_dir)
+
+    scene.paint_lut.eevee_mode = "EXACT"
+    assert not api.is_current(material, api.paint_of(material), directory=lut_dir)
+    layout = _Layout()
+    panels.draw_settings(layout, material, scene)
+    assert any(t.endswith("the scene asks Exact: bake to apply") for t, _ in layout.labels)
+    result = api.bake_material(material, directory=lut_dir)
+    assert result.computed == ["EEVEE"]  # the LUT and the Cycles fit were current
+    fit = api.fit_errors(material)["EEVEE"]
+    assert fit.eevee_mode == "EXACT" and fit.exact and fit.samples == 1
+    assert fit.error > 0.15  # what the converged fit bought
+    entry = batch._fit_entry(material)["fit"]
+    assert entry["EEVEE"] | {"error": 0} == {
+        "error": 0, "target": fit.target, "grazing": round(fit.grazing, 5), "grazing_target": fit.grazing_target,
+        "mode": "EXACT", "exact_at_one_sample": True, "samples": 1,
+    }  # fmt: skip
+    assert "mode" not in entry["CYCLES"]
+    assert api.is_current(material, api.paint_of(material), directory=lut_dir)
