@@ -199,13 +199,21 @@ def _print_fits(paint, args) -> None:
     paint, whole and over the grazing band, with the goals."""
     calibration = max(eevee.available_versions(), default=None)
     options = {k: getattr(args, k) for k in ("resolution", "single_nodes", "diffuse_nodes")}
-    result = render_bake.bake_for_render(paint, args.out, eevee_calibration=calibration, **options)
+    result = render_bake.bake_for_render(
+        paint, args.out, eevee_calibration=calibration, eevee_mode=args.eevee_mode, **options
+    )
     for target, (whole, grazing) in result.all_errors(paint).items():
-        goals = result.fits[target].goals
+        fit = result.fits[target]
+        goals = fit.goals
         misses = whole > goals[0] or grazing > goals[1]
+        drawn = ""
+        if target == "EEVEE":
+            exact = fit.sums_exactly
+            samples = eevee.samples_needed(fit, result.lut.amplitudes(paint))
+            drawn = ", exact at 1 sample" if exact else f", converged: about {samples} samples"
         print(
             f"  {target.title()} fit: {100 * whole:.2f}% (goal {100 * goals[0]:.0f}%), grazing light"
-            f" {100 * grazing:.2f}% (goal {100 * goals[1]:.0f}%){'  MISSES' if misses else ''}"
+            f" {100 * grazing:.2f}% (goal {100 * goals[1]:.0f}%){drawn}{'  MISSES' if misses else ''}"
         )
 
 
@@ -338,6 +346,13 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="also fit the closures of Cycles and EEVEE and print the fidelity measure each reports for the paint"
         " (whole and grazing light, with the goals)",
+    )
+    b.add_argument(
+        "--eevee-mode",
+        choices=render_bake.fitting.EEVEE_MODES,
+        default=render_bake.fitting.DEFAULT_EEVEE_MODE,
+        help="with --fit: EEVEE's fit exact at one sample, or converged over samples (more closures where the"
+        " exact one misses its goal; default %(default)s)",
     )
 
     parser.bake_parser = b  # its own usage line for errors found after parsing

@@ -1,5 +1,6 @@
 """The command line: python -m lut example | bake | info."""
 
+import re
 import subprocess
 import sys
 
@@ -98,3 +99,22 @@ def test_bake_with_fit_reports_the_fidelity_measure_of_each_engine(tmp_path, cap
         assert shown[:2] == pytest.approx((100 * whole, 100 * grazing), abs=0.006)
         goals = result.fits[target].goals
         assert shown[2] == (whole > goals[0] or grazing > goals[1])
+    exact = result.fits["EEVEE"].sums_exactly
+    assert re.search(r"Eevee fit: .*(, exact at 1 sample|, converged: about \d+ samples)", out)
+    assert (", exact at 1 sample" in out) == exact
+
+
+def test_bake_with_fit_draws_eevee_in_the_mode_asked(tmp_path, capsys):
+    """``--eevee-mode``: a sharp exponential paint, which EEVEE's three
+    exact closures miss, converges over samples by default and is exact at
+    one sample when asked; an unknown mode is refused by name."""
+    args = ["bake", "--out", str(tmp_path), "--fit", "--slope", "0.0785", "--distribution", "exponential"]
+    args += ["--n", "1.735", "--rho", "0.0926", "0.0141", "0.017", "--single", "0.0705", "0.2976", "0.0487"]
+    args += ["--g", "0.41", "--facet", "0.677"]  # random_paints(24)[21]: exact 24.9%, converged 8.8%
+    assert main(args) == 0
+    assert re.search(r"Eevee fit: .*, converged: about \d+ samples", capsys.readouterr().out)
+    assert main([*args, "--eevee-mode", "EXACT"]) == 0
+    assert ", exact at 1 sample" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        main([*args, "--eevee-mode", "FAST"])
+    assert "--eevee-mode: invalid choice: 'FAST'" in capsys.readouterr().err
