@@ -308,6 +308,7 @@ def test_bake_wires_a_group_per_engine_with_colour_inputs(material, lut_dir):
     assert any(nd.type == "BSDF_TOON" for nd in _group_node(material).node_tree.nodes)
     names = sorted(p.name.rsplit("-", 1)[0] for p in lut_dir.iterdir())
     calibrated = "".join(map(str, api.eevee_calibration()))  # EEVEE fitted with this Blender's measured closures
+    calibrated += "c"  # in the scene's default mode, Converged
     version = f"f{fitting.FIT_VERSION}"  # in the name: an older release's files are never overwritten
     assert names == [f"paintfit-cycles-{version}", f"paintfit-eevee{calibrated}-{version}", "paintlut"]
     # A texture driving the pigment survives a rebake; still two outputs and two group nodes.

@@ -282,7 +282,7 @@ def test_clean_removes_only_luts_and_weights_nothing_keeps(tmp_path, capsys):
     kept = lut.bake(lut.Paint(rho=0.2), tmp_path, resolution=(8, 6, 4))
     gone = lut.bake(lut.Paint(n=1.6, rho=0.7), tmp_path, resolution=(8, 6, 4))  # another paint type
     for path in (kept, gone):
-        for prefix in ("paintfit-cycles-", "paintfit-eevee50-f6-"):
+        for prefix in ("paintfit-cycles-", "paintfit-eevee50-f6-", "paintfit-eevee50c-f8-"):
             path.with_name(path.name.replace("paintlut-", prefix)).write_bytes(b"weights")
     other = tmp_path / "notes.exr"
     other.write_bytes(b"x")
@@ -293,13 +293,14 @@ def test_clean_removes_only_luts_and_weights_nothing_keeps(tmp_path, capsys):
 
     assert main(["clean", str(tmp_path), "--keep", str(kept), "--dry-run"]) == 0
     assert sorted(tmp_path.iterdir()) == before
-    assert "would remove 4 file(s)" in capsys.readouterr().out
+    assert "would remove 5 file(s)" in capsys.readouterr().out
     assert main(["clean", str(tmp_path), "--keep", str(kept)]) == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
         [kept.name, "notes.exr", kept.name.replace("paintlut-", "paintfit-cycles-"),
-         kept.name.replace("paintlut-", "paintfit-eevee50-f6-")]
+         kept.name.replace("paintlut-", "paintfit-eevee50-f6-"),
+         kept.name.replace("paintlut-", "paintfit-eevee50c-f8-")]
     )  # fmt: skip
-    assert "removed 4 file(s)" in capsys.readouterr().out
+    assert "removed 5 file(s)" in capsys.readouterr().out
     with pytest.raises(ValueError, match="not a LUT"):
         cleanup.clean(tmp_path, keep=[other])
     assert main(["clean", str(tmp_path / "missing"), "--keep"]) == 2
