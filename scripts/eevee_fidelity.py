@@ -7,7 +7,8 @@ running Blender line (the README's EEVEE column).
 
 Method.  Every paint of ``lut.bench.random_paints`` is made a material by the
 add-on (``addon.api``: its type baked, fitted for EEVEE against the running
-line's measured closure responses) and put on its own sphere of the
+line's measured closure responses, in the scene's EEVEE mode Exact at 1
+sample) and put on its own sphere of the
 calibration scene (``calibrate_eevee.SphereScene``: orthographic camera, delta
 Sun without shadows, black world, one sample per pixel, film filter off).
 One render fixes the angle γ between light and view; a sweep of γ gives
@@ -48,18 +49,22 @@ GAMMAS = tuple(range(0, 176, 10))
 CELL = 48
 
 
-def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None):
+def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None, eevee_mode="EXACT"):
     """Per (label, lut.Paint) of ``paints`` (materials baked in
     ``directory``): {"label", "paint", "eevee" (rendered error), "eevee_fit"
     and "cycles_fit" (the errors the fits report), "bins"}, and with
     ``cycles`` "cycles" (the same spheres in Cycles against the model) and
     "eevee_vs_cycles" (EEVEE's pixels against Cycles'); each error also as
     "<key>_grazing", over the grazing band.  ``raw``: a dict to receive each
-    paint's samples.  The add-on must be registered."""
+    paint's samples.  ``eevee_mode``: the scene's EEVEE mode the materials
+    are baked in; the sweep renders one sample, which is all an "EXACT" fit
+    needs (a converged one is measured by ``scripts/eevee_converged.py``).
+    The add-on must be registered."""
     from addon import api
     from scripts.calibrate_eevee import SphereScene
 
     scene = SphereScene([None] * len(paints), cell=cell)
+    scene.scene.paint_lut.eevee_mode = eevee_mode
     rows = []
     for sphere, (label, paint) in zip(scene.objects, paints, strict=True):
         material = api.new_material(label, paint, directory=directory)

@@ -81,8 +81,10 @@ def test_bake_cache_edit_and_corruption(tmp_path):
     computed = sorted(entry["materials"][name]["computed"] for name in ("red", "blue"))
     assert computed == [[], ["lut", "CYCLES", "EEVEE"]]  # the second found the first's bake
     assert set(entry["materials"]["blue"]["fit"]) == {"CYCLES", "EEVEE"}
-    for fit in entry["materials"]["blue"]["fit"].values():  # the measure, whole and over the grazing band
-        assert set(fit) == {"error", "target", "grazing", "grazing_target"}
+    for engine, fit in entry["materials"]["blue"]["fit"].items():  # the measure, whole and over the grazing band
+        drawn = {"mode", "exact_at_one_sample", "samples"} if engine == "EEVEE" else set()  # how EEVEE draws it
+        assert set(fit) == {"error", "target", "grazing", "grazing_target"} | drawn
+    assert entry["materials"]["blue"]["fit"]["EEVEE"]["mode"] == "CONVERGED"  # the scene's default
     assert "one bake of paint type" in done.stdout and "shared by blue, red" in done.stdout
     assert not list(tmp_path.glob("*.partial*")) and not (tmp_path / "scene.blend1").exists()
     # The saved file refers to its LUTs relative to itself and is wired.

@@ -97,9 +97,10 @@ def test_cycles_renders_every_paint_within_its_target_on_the_dense_measure(rando
 
 @pytest.mark.render
 def test_eevee_renders_the_randomised_set_as_measured(randomised):
-    """EEVEE (one sample, its own closure approximations, at most two exact
-    reflection lobes; the viewport's Material Preview and a final EEVEE
-    render are the same engine) against the model: bounds a little above
+    """EEVEE's exact fits (the scene's EEVEE mode Exact at 1 sample: one
+    sample, its own closure approximations, at most two exact reflection
+    lobes; the viewport's Material Preview and a final EEVEE render are the
+    same engine) against the model: bounds a little above
     what this set measures on Blender 5.0 and 5.2 (README), so a broken
     calibration, fit or texture lookup shows.  Smooth paints: the median
     within 5%; rough: the median within 16%; none beyond 45%.  And the error
