@@ -666,7 +666,7 @@ def fit_lut(
             lut, target, evaluate, basis, theta_v, theta_l, phi, row_w, model, budget, extra_budget, exact
         )  # fmt: skip
         if best is None or fitted[-1] < best[-1]:
-            best = fitted
+            best, best_rows = fitted, row_set
         if best[-1] <= 1.0:  # every colour of the type meets both goals: the next sets need not be tried
             break
     if eevee_mode == "CONVERGED" and best[-1] > 1.0:
@@ -681,16 +681,15 @@ def fit_lut(
             cos_view=cos_view,
             calibration=calibration,
         )
-        for row_set in row_sets:
-            theta_l, phi, row_w = _rows(row_set, theta_v, grid)
-            fitted = _fit_rows(
-                lut, target, evaluate, wide, theta_v, theta_l, phi, row_w, model,
-                int(converged_budget), int(converged_extra), False, noise,
-            )  # fmt: skip
-            if fitted[-1] < CONVERGED_GAIN * best[-1]:
-                best = fitted
-            if best[-1] <= 1.0:
-                break
+        # On the rows the exact fit did best on (each set of rows costs a
+        # selection of up to 12 closures and a noise estimate per step).
+        theta_l, phi, row_w = _rows(best_rows, theta_v, grid)
+        fitted = _fit_rows(
+            lut, target, evaluate, wide, theta_v, theta_l, phi, row_w, model,
+            int(converged_budget), int(converged_extra), False, noise,
+        )  # fmt: skip
+        if fitted[-1] < CONVERGED_GAIN * best[-1]:
+            best = fitted
     basis_kept, weights, whole, band, _ = best
     n = reference_index(type_dict["n"])
     dense = view_cosines(texture_views(views))
@@ -717,19 +716,26 @@ def fit_lut(
 def _viewport_spread(kept, weights, values, *, points, mirror, n, cos_view, calibration):
     """{component: per-pixel spread (``eevee.spread_of``) of EEVEE's render
     of closures ``kept`` with ``weights`` at ``eevee.VIEWPORT_SAMPLES``} for
-    the colour of that component alone (a black paint is all facet), on the
-    measure's geometries ``points``, where the closures' responses are
-    ``values``."""
+    the colour of that component alone (a black paint is all facet), or of
+    every component at once where that is noisier (a closure serving
+    several components is picked by its whole colour, which need not follow
+    its contribution), on the measure's geometries ``points``, where the
+    closures' responses are ``values``."""
     from . import eevee
 
     version = tuple(calibration) if calibration is not None else None
+
+    def spread(amps):
+        return eevee.spread_of(
+            kept, weights, cos_view, mirror, n, amps, points, version, eevee.VIEWPORT_SAMPLES, values
+        )
+
+    mixed = spread(np.ones((3, len(COMPONENTS))))
     spreads = []
     for c in range(len(COMPONENTS)):
         amps = np.zeros((3, len(COMPONENTS)))
         amps[:, c] = 1.0
-        spreads.append(
-            eevee.spread_of(kept, weights, cos_view, mirror, n, amps, points, version, eevee.VIEWPORT_SAMPLES, values)
-        )
+        spreads.append(max(spread(amps), mixed))
     return dict(zip(COMPONENTS, spreads, strict=True))
 
 
@@ -841,7 +847,11 @@ def _fit_rows(
             return values[closure]
 
         best = None
+        from . import eevee
+
         for n in range(1, len(chosen) + 1):
+            if eevee.sums_exactly([basis[k] for k in chosen[:n]], mirror) and n < len(chosen):
+                continue  # the exact fit, made on its own, does better with as few
             fitted = weights_of(chosen[:n], cached)
             noisy = shortfall(*fitted[2:], goals, noise(*fitted[:2], [values[c] for c in fitted[0]]))
             if best is None or noisy < best[-1]:
