@@ -217,23 +217,32 @@ def fit_errors(material) -> dict:
         whole, grazing = fitting.reported_errors(f, amps)
         kind = measure.goals(target, paint.slope == 0)  # an earlier release stored the whole goal alone
         goals = f.get("goals") or (f.get("goal", kind[0]), kind[1])
-        noise = {}
-        if target == "EEVEE":
-            bound = max(whole, eevee.NOISE_FLOOR)
-            noise = {
-                "eevee_mode": f.get("eevee_mode", "EXACT"), "exact": bool(f.get("exact", True)),
-                "samples": eevee.samples_for(float(f.get("spread", 0.0)), bound),
-            }  # fmt: skip
-        out[target] = FitError(whole, float(goals[0]), grazing, float(goals[1]), **noise)
+        out[target] = FitError(whole, float(goals[0]), grazing, float(goals[1]), **_drawn(target, f, whole))
     return out
 
 
 def _result_errors(result: render_bake.RenderBake, paint) -> dict:
     """{engine: FitError} of a bake's fits at a paint's colours."""
+    out = {}
+    for target, (whole, grazing) in result.all_errors(paint).items():
+        fit = result.fits[target]
+        out[target] = FitError(whole, fit.goals[0], grazing, fit.goals[1], **_drawn(target, fit.grams() | {
+            "eevee_mode": fit.eevee_mode, "exact": fit.sums_exactly, "spread": eevee.type_spread(fit),
+        }, whole))  # fmt: skip
+    return out
+
+
+def _drawn(target, stored: dict, whole: float) -> dict:
+    """How EEVEE draws a fit (``FitError``'s last fields) from what a
+    material stores of it: its mode, whether exact at one sample, and the
+    samples its noisiest colour needs to fall below ``whole``, the fit's
+    error at the material's colour (``eevee.NOISE_FLOOR`` at least)."""
+    if target != "EEVEE":
+        return {}
     return {
-        target: FitError(whole, result.fits[target].goals[0], grazing, result.fits[target].goals[1])
-        for target, (whole, grazing) in result.all_errors(paint).items()
-    }
+        "eevee_mode": stored.get("eevee_mode", "EXACT"), "exact": bool(stored.get("exact", True)),
+        "samples": eevee.samples_for(float(stored.get("spread", 0.0)), max(whole, eevee.NOISE_FLOOR)),
+    }  # fmt: skip
 
 
 def set_paint(material, paint: lut.Paint) -> None:

@@ -162,7 +162,10 @@ def linked_status(material, exact_metallic=None) -> dict:
             table = lut.load_lut(path)
             exact = nodes.exact_metallic_default(exact_metallic)
             for target in closures.TARGETS:
-                fit_file = fitting.fit_path(path, target, exact, api.eevee_calibration(), api.eevee_mode())
+                # The EEVEE mode the library baked it in (its group says), not this file's.
+                node = nodes.group_of(material, "EEVEE")
+                mode = node.node_tree.get("paint_lut_eevee_mode", "EXACT") if node is not None else "EXACT"
+                fit_file = fitting.fit_path(path, target, exact, api.eevee_calibration(), mode)
                 fitted = fitting.read_fit(fit_file)
                 baked_node = nodes.group_of(material, target)
                 if fitted.lut_key != table.key or baked_node is None or not nodes.is_paint_group(baked_node.node_tree):

@@ -209,7 +209,8 @@ def _print_fits(paint, args) -> None:
         drawn = ""
         if target == "EEVEE":
             exact = fit.sums_exactly
-            samples = eevee.samples_needed(fit, result.lut.amplitudes(paint))
+            # As the panel has it: the type's noisiest colour, down to this colour's error.
+            samples = eevee.samples_for(eevee.type_spread(fit), max(whole, eevee.NOISE_FLOOR))
             drawn = ", exact at 1 sample" if exact else f", converged: about {samples} samples"
         print(
             f"  {target.title()} fit: {100 * whole:.2f}% (goal {100 * goals[0]:.0f}%), grazing light"

@@ -73,11 +73,13 @@ def main(argv=None):
     all_paints = paints()
     for name in args.paints:
         paint = all_paints[name]
-        baked = render_bake.bake_for_render(paint, directory, targets=("EEVEE",), eevee_calibration=version)
+        baked = render_bake.bake_for_render(
+            paint, directory, targets=("EEVEE",), eevee_calibration=version, eevee_mode="EXACT"
+        )  # the exact fits, rendered at one sample
         table, default = baked.lut, baked.fits["EEVEE"]
         amps = table.amplitudes(paint)
         variants = {
-            "Cycles formulas": fitting.fit_lut(table, "EEVEE"),
+            "Cycles formulas": fitting.fit_lut(table, "EEVEE", eevee_mode="EXACT"),
             "calibrated (add-on)": default,
         }
         for i, (label, fit) in enumerate(variants.items()):

@@ -88,7 +88,7 @@ def main(argv=None) -> int:
         for i in args.paints:
             label, paint = paints[i]
             table = baking.load_lut(baking.bake(paint, pathlib.Path(tmp)))
-            fit = fitting.fit_lut(table, "EEVEE", calibration=version)
+            fit = fitting.fit_lut(table, "EEVEE", calibration=version, eevee_mode="EXACT")
             basis = [Closure("lambert")] + [Closure("glossy", roughness=r) for r in ROUGHNESS]
             chosen = [c for c in fit.closures if c.kind != "lambert"]
             basis += chosen

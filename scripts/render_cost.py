@@ -118,7 +118,9 @@ def main(argv=None):
         material = api.new_material(name, paint, directory=directory)
         sphere.data.materials[0] = material
         t = timed(sc)
-        cached = render_bake.bake_for_render(paint, directory, eevee_calibration=api.eevee_calibration())
+        cached = render_bake.bake_for_render(
+            paint, directory, eevee_calibration=api.eevee_calibration(), eevee_mode=api.eevee_mode()
+        )  # what api.new_material baked
         counted = sum(c.cost for c in cached.fits[args.engine].closures)
         print(f"{name:28} {t:.3f} s  ratio {t / base:.2f}  ({counted} closures)")
 

@@ -88,7 +88,8 @@ def test_the_spread_is_the_variance_of_eevees_closure_selection(random_set):
     tl, tv, ph = (a[::97] for a in measure.points(fit.mirror))
     values = np.array([eevee.evaluate(c, tl, tv, ph, CALIBRATION) for c in fit.closures])
     colours = eevee._colours(fit.weights, fit.cos_view, amps, tv)
-    contributions, select = eevee._selection(fit.closures, colours, float(amps[:, 0].mean()), None, values)
+    mirror_n = fit.n if fit.mirror else None
+    contributions, select = eevee._selection(fit.closures, colours, float(amps[:, 0].mean()), mirror_n, values)
     which = np.array(eevee.bins(fit.closures, fit.mirror))
     draws = 20000
     estimate = np.zeros((draws, tl.size, 3))

@@ -716,19 +716,26 @@ def fit_lut(
 def _viewport_spread(kept, weights, values, *, points, mirror, n, cos_view, calibration):
     """{component: per-pixel spread (``eevee.spread_of``) of EEVEE's render
     of closures ``kept`` with ``weights`` at ``eevee.VIEWPORT_SAMPLES``} for
-    the colour of that component alone (a black paint is all facet), on the
-    measure's geometries ``points``, where the closures' responses are
-    ``values``."""
+    the colour of that component alone (a black paint is all facet), or of
+    every component at once where that is noisier (a closure serving
+    several components is picked by its whole colour, which need not follow
+    its contribution), on the measure's geometries ``points``, where the
+    closures' responses are ``values``."""
     from . import eevee
 
     version = tuple(calibration) if calibration is not None else None
+
+    def spread(amps):
+        return eevee.spread_of(
+            kept, weights, cos_view, mirror, n, amps, points, version, eevee.VIEWPORT_SAMPLES, values
+        )
+
+    mixed = spread(np.ones((3, len(COMPONENTS))))
     spreads = []
     for c in range(len(COMPONENTS)):
         amps = np.zeros((3, len(COMPONENTS)))
         amps[:, c] = 1.0
-        spreads.append(
-            eevee.spread_of(kept, weights, cos_view, mirror, n, amps, points, version, eevee.VIEWPORT_SAMPLES, values)
-        )
+        spreads.append(max(spread(amps), mixed))
     return dict(zip(COMPONENTS, spreads, strict=True))
 
 
@@ -849,7 +856,7 @@ def _fit_rows(
             noisy = shortfall(*fitted[2:], goals, noise(*fitted[:2], [values[c] for c in fitted[0]]))
             if best is None or noisy < best[-1]:
                 best = (*fitted, noisy)
-        return best
+        return best if best is not None else (*weights_of([], cached), float("inf"))
     chosen, shared = _select(gram, rhs, norm, allowed, upper, cost, budget, goal**2, caps)
     basis_kept, weights, whole, band = weights_of(chosen)
     if extra_budget > 0 and score(whole, band) > 1.0:
