@@ -152,8 +152,7 @@ def store_result(material, paint: lut.Paint, result: render_bake.RenderBake, exa
         {
             target: {
                 **f.grams(), "goal": f.target_error, "goals": list(f.goals),
-                **({"eevee_mode": f.eevee_mode, "exact": f.sums_exactly, "spread": eevee.type_spread(f)}
-                   if target == "EEVEE" else {}),
+                **(_drawing(f) if target == "EEVEE" else {}),
             }
             for target, f in result.fits.items()
         }
@@ -226,10 +225,14 @@ def _result_errors(result: render_bake.RenderBake, paint) -> dict:
     out = {}
     for target, (whole, grazing) in result.all_errors(paint).items():
         fit = result.fits[target]
-        out[target] = FitError(whole, fit.goals[0], grazing, fit.goals[1], **_drawn(target, fit.grams() | {
-            "eevee_mode": fit.eevee_mode, "exact": fit.sums_exactly, "spread": eevee.type_spread(fit),
-        }, whole))  # fmt: skip
+        out[target] = FitError(whole, fit.goals[0], grazing, fit.goals[1], **_drawn(target, _drawing(fit), whole))
     return out
+
+
+def _drawing(fit) -> dict:
+    """What a material stores of how EEVEE draws a fit: its mode, whether it
+    sums exactly at one sample, and its noisiest colour's spread."""
+    return {"eevee_mode": fit.eevee_mode, "exact": fit.sums_exactly, "spread": fit.noisiest_spread}
 
 
 def _drawn(target, stored: dict, whole: float) -> dict:

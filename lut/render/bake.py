@@ -126,7 +126,7 @@ def bake_for_render(
         paths[target] = fitting.fit_path(path, target, exact_metallic, calibration, mode)
         fitted = None if force else _cached_fit(paths[target], table, target, exact_metallic, calibration, mode)
         if fitted is None:
-            todo[target] = calibration
+            todo[target] = (calibration, mode)
         else:
             fits[target] = fitted
     # The engines' fits are independent: one thread each (numpy releases the
@@ -135,14 +135,9 @@ def bake_for_render(
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, len(todo))) as pool:
         futures = {
             pool.submit(
-                fitting.fit_lut,
-                table,
-                target,
-                exact_metallic=exact_metallic,
-                calibration=calibration,
-                eevee_mode=eevee_mode if target == "EEVEE" else "EXACT",
+                fitting.fit_lut, table, target, exact_metallic=exact_metallic, calibration=calibration, eevee_mode=mode
             ): target
-            for target, calibration in todo.items()
+            for target, (calibration, mode) in todo.items()
         }
         try:
             for future in concurrent.futures.as_completed(futures):

@@ -232,9 +232,9 @@ def sums_exactly(closures, mirror: bool) -> bool:
     return reflections <= EXACT_REFLECTION_CLOSURES and len(normals) <= 1
 
 
-#: Render samples of an EEVEE final render and of its viewport (Blender's
-#: defaults, ``scene.eevee.taa_render_samples`` and ``taa_samples``).
-RENDER_SAMPLES = 64
+#: Render samples of an EEVEE viewport (Blender's default,
+#: ``scene.eevee.taa_samples``): the noise a converged fit may spend is
+#: judged there.
 VIEWPORT_SAMPLES = 16
 #: ``samples_needed``: a render has converged where its per-pixel spread
 #: is below the fit's own error at that colour (more samples no longer
@@ -242,8 +242,8 @@ VIEWPORT_SAMPLES = 16
 NOISE_FLOOR = 0.02
 #: How the spread falls with samples: as N^-CONVERGENCE.  EEVEE's sample
 #: sequence is stratified, faster than independent samples' N^-0.5:
-#: measured on a flat plane (``scripts/eevee_converged.py --noise``) the
-#: spread fell 6-9 fold from 1 to 16 samples and 18-20 fold to 64.
+#: measured on a flat plane (``scripts/eevee_converged.py --render``) the
+#: spread fell 5-9 fold from 1 to 16 samples and 18-20 fold to 64.
 CONVERGENCE = 0.7
 
 
@@ -377,14 +377,16 @@ def samples_for(one: float, bound: float, most=4096) -> int:
     return samples
 
 
+def component_colours(components: int) -> list:
+    """Amplitudes (3 channels, C) of each component alone at unit colour:
+    the colours a type's noise is judged at (a black paint is all facet)."""
+    return [np.repeat(np.eye(components)[c][None], 3, axis=0) for c in range(components)]
+
+
 def type_spread(fit) -> float:
     """The spread at one sample (``spread``) of a type's noisiest colour:
-    the largest over the colours of one component alone."""
+    the largest over the colours of one component alone
+    (``component_colours``)."""
     if fit.target != "EEVEE" or fit.sums_exactly:
         return 0.0
-    out = 0.0
-    for c in range(fit.weights.shape[1]):
-        amps = np.zeros((3, fit.weights.shape[1]))
-        amps[:, c] = 1.0
-        out = max(out, spread(fit, amps))
-    return out
+    return max(spread(fit, amps) for amps in component_colours(fit.weights.shape[1]))

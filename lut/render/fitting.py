@@ -89,12 +89,11 @@ EXTRA_BUDGET = {"CYCLES": 4, "EEVEE": 0}
 #: GLSL).  "EXACT": at most the closures EEVEE sums exactly at one sample
 #: (``BUDGET["EEVEE"]``); "CONVERGED": where that misses a goal of the
 #: measure, up to ``CONVERGED_BUDGET`` closures (+ ``CONVERGED_EXTRA``),
-#: exact once samples average them (``lut.render.eevee.noise`` says how
-#: many it takes).  A type whose exact fit meets its goals keeps it in
+#: exact once samples average them (``lut.render.eevee.spread`` says how
+#: noisy, ``samples_needed`` how many samples it takes).  A type whose exact fit meets its goals keeps it in
 #: either mode: it renders noise-free at one sample.
 EEVEE_MODES = ("EXACT", "CONVERGED")
-#: The mode a bake fits EEVEE in unless told otherwise (final renders take
-#: ``eevee.RENDER_SAMPLES`` samples, the viewport ``eevee.VIEWPORT_SAMPLES``).
+#: The mode a bake fits EEVEE in unless told otherwise.
 DEFAULT_EEVEE_MODE = "CONVERGED"
 CONVERGED_BUDGET = 8
 CONVERGED_EXTRA = 4
@@ -221,6 +220,15 @@ class Fit:
         from . import eevee
 
         return eevee.sums_exactly(self.closures, self.mirror)
+
+    @functools.cached_property
+    def noisiest_spread(self) -> float:
+        """EEVEE's per-pixel spread at one sample for the type's noisiest
+        colour (``eevee.type_spread``; 0 where it sums exactly), computed
+        once per fit: the material stores it, a bake's status reports it."""
+        from . import eevee
+
+        return eevee.type_spread(self)
 
     @property
     def rough(self) -> bool:
@@ -731,11 +739,7 @@ def _viewport_spread(kept, weights, values, *, points, mirror, n, cos_view, cali
         )
 
     mixed = spread(np.ones((3, len(COMPONENTS))))
-    spreads = []
-    for c in range(len(COMPONENTS)):
-        amps = np.zeros((3, len(COMPONENTS)))
-        amps[:, c] = 1.0
-        spreads.append(max(spread(amps), mixed))
+    spreads = [max(spread(amps), mixed) for amps in eevee.component_colours(len(COMPONENTS))]
     return dict(zip(COMPONENTS, spreads, strict=True))
 
 
@@ -774,9 +778,9 @@ def _fit_rows(
     """Select closures and fit their weights on the given rows (``exact``:
     within the closures EEVEE sums exactly at one sample; ``noise``: for a
     converged EEVEE fit, the spread of closures and weights at the
-    viewport's samples, ``_viewport_spread``: the selection's first n
-    closures nearest the goals whose spread is within
-    ``eevee.NOISE_BOUND`` are kept); returns
+    viewport's samples, ``_viewport_spread``: of the selection's first n
+    closures, those nearest the goals with their spread counted in,
+    ``shortfall``, are kept); returns
     (closures kept, weights (K, C, M, T), the measure's whole and grazing
     Gram matrices, the worst component's error on the measure)."""
     type_dict = lut.meta["type"]
@@ -846,9 +850,9 @@ def _fit_rows(
                 values[closure] = evaluate(closure, tl, tv, ph)
             return values[closure]
 
-        best = None
         from . import eevee
 
+        best = None
         for n in range(1, len(chosen) + 1):
             if eevee.sums_exactly([basis[k] for k in chosen[:n]], mirror) and n < len(chosen):
                 continue  # the exact fit, made on its own, does better with as few
