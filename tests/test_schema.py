@@ -18,7 +18,18 @@ from lut.paint.schema import PAINT_FIELDS, Range
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 #: The bake command's options that are not paint fields.
-NOT_PAINT_OPTIONS = {"help", "preset", "paint", "out", "resolution", "single_nodes", "diffuse_nodes", "force", "fit"}
+NOT_PAINT_OPTIONS = {
+    "help",
+    "preset",
+    "paint",
+    "out",
+    "resolution",
+    "single_nodes",
+    "diffuse_nodes",
+    "force",
+    "fit",
+    "eevee_mode",
+}
 NUMBERS = [name for name, spec in PAINT_FIELDS.items() if spec.kind in ("index", "number")]
 COLOURS = [name for name, spec in PAINT_FIELDS.items() if spec.kind == "colour"]
 
