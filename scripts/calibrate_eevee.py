@@ -8,11 +8,15 @@ filter off, to 32-bit multilayer EXR with the Normal pass.  Every pixel is
 one geometry: from its shading normal n (the pass), the view v = +Z and the
 light l, (θl, θv, φ) in ``lut.models``' convention (light at azimuth π, φ = 0
 the mirror direction).  One render fixes the angle γ between l and v; a
-sweep of γ covers (θl, θv, |φ|).  The pixels are binned on a grid of (θl,
-θv, |φ|) and each bin stores the ratio Σ EEVEE / Σ reference of its pixels,
-the reference being a smooth analytic model of what EEVEE approximates
-(``lut.render.eevee.reference``): so a table cell is a slowly varying correction,
-and lobes of any roughness keep their analytic shape between cells.
+sweep of γ covers (θl, θv, |φ|).  A table on a grid of (θl, θv, |φ|) holds
+the ratio of EEVEE to a reference, a smooth analytic model of what EEVEE
+approximates (``lut.render.eevee.reference``): so a table cell is a slowly
+varying correction, and lobes of any roughness keep their analytic shape
+between cells.  The table is the least-squares fit of its trilinear
+interpolation to the pixels (``lut.render.eevee.fit_table``), held near the
+binned ratio Σ EEVEE / Σ reference of each cell's pixels where few pixels
+reach it: binning alone is biased near a sharp lobe's mirror at grazing
+angles, where a cell's pixels are weighted toward its brighter side.
 
 Run ``python scripts/calibrate_eevee.py`` with a Python whose ``bpy`` renders
 EEVEE; the tables of that Blender line (``bpy.app.version[:2]``) are added to
@@ -42,7 +46,7 @@ from lut.render import eevee  # noqa: E402
 from lut.render.closures import RETRO_ROUGHNESS, Closure  # noqa: E402
 
 #: The generated module of tables.
-MODULE = ROOT / "lut" / "eevee_tables.py"
+MODULE = ROOT / "lut" / "render" / "eevee_tables.py"
 #: Pixels across one sphere's cell in the render.
 CELL = 96
 #: Angles γ between light and view of the sweep (degrees).
@@ -276,6 +280,17 @@ def bin_ratios(samples, closure):
     return ratio, count
 
 
+def fitted_table(closure, sample):
+    """The table of ``closure`` from its pixels ``sample`` (θl, θv, φ,
+    radiance): the least-squares fit of ``lut.render.eevee.fit_table`` about
+    the binned ratios, pixels within 1° of the horizon left out as in
+    ``bin_ratios``."""
+    prior = eevee.fill(bin_ratios([sample], closure)[0])
+    tl, tv, ph, value = (np.asarray(a, dtype=float) for a in sample)
+    keep = (tl < np.radians(89.0)) & (tv < np.radians(89.0))
+    return eevee.fit_table(closure, tl[keep], tv[keep], ph[keep], value[keep], prior)
+
+
 def write_module(path, version, tables, merge=False):
     """Write ``lut/render/eevee_tables.py``: the tables of ``version`` replace that
     line's (``merge``: are added to that line's, replacing only those of the
@@ -351,7 +366,7 @@ def main(argv=None):
         if args.raw:
             flat = {f"{eevee.table_key(c)}/{j}": s[j] for c, s in zip(todo, samples, strict=True) for j in range(4)}
             np.savez_compressed(args.raw, version=version, **flat)
-    tables = {eevee.table_key(c): eevee.fill(bin_ratios([s], c)[0]) for c, s in zip(todo, samples, strict=True)}
+    tables = {eevee.table_key(c): fitted_table(c, s) for c, s in zip(todo, samples, strict=True)}
     write_module(args.out, version, tables, merge=bool(args.only))
     print(f"wrote {len(tables)} tables for Blender {version} to {args.out}")
 
