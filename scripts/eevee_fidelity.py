@@ -4,6 +4,7 @@ running Blender line (the README's EEVEE column).
     .venv/bin/python scripts/eevee_fidelity.py [--random 24] [--seed 2026] [--out FILE.json]
     .venv/bin/python scripts/eevee_fidelity.py --named   # the presets and named paints
     .venv-bpy52/bin/python scripts/eevee_fidelity.py      # Blender 5.2 LTS
+    .venv/bin/python scripts/eevee_fidelity.py --eevee-mode CONVERGED   # at 64 samples
 
 Method.  Every paint of ``lut.bench.random_paints`` is made a material by the
 add-on (``addon.api``: its type baked, fitted for EEVEE against the running
@@ -49,7 +50,7 @@ GAMMAS = tuple(range(0, 176, 10))
 CELL = 48
 
 
-def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None, eevee_mode="EXACT"):
+def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None, eevee_mode="EXACT", samples=1):
     """Per (label, lut.Paint) of ``paints`` (materials baked in
     ``directory``): {"label", "paint", "eevee" (rendered error), "eevee_fit"
     and "cycles_fit" (the errors the fits report), "bins"}, and with
@@ -57,14 +58,15 @@ def measure(paints, directory, gammas=GAMMAS, cycles=False, cell=CELL, raw=None,
     "eevee_vs_cycles" (EEVEE's pixels against Cycles'); each error also as
     "<key>_grazing", over the grazing band.  ``raw``: a dict to receive each
     paint's samples.  ``eevee_mode``: the scene's EEVEE mode the materials
-    are baked in; the sweep renders one sample, which is all an "EXACT" fit
-    needs (a converged one is measured by ``scripts/eevee_converged.py``).
+    are baked in; ``samples``: EEVEE's samples per pixel (one is all an
+    "EXACT" fit needs; a "CONVERGED" one is drawn at a final render's 64).
     The add-on must be registered."""
     from addon import api
     from scripts.calibrate_eevee import SphereScene
 
     scene = SphereScene([None] * len(paints), cell=cell)
     scene.scene.paint_lut.eevee_mode = eevee_mode
+    scene.scene.eevee.taa_render_samples = samples
     rows = []
     for sphere, (label, paint) in zip(scene.objects, paints, strict=True):
         material = api.new_material(label, paint, directory=directory)
@@ -147,6 +149,13 @@ def main(argv=None) -> int:
     parser.add_argument("--out", type=pathlib.Path, default=default_out)
     parser.add_argument("--luts", type=pathlib.Path, help="bake into (and reuse) this folder, not a temporary one")
     parser.add_argument(
+        "--eevee-mode",
+        choices=("EXACT", "CONVERGED"),
+        default="EXACT",
+        help="the scene's EEVEE mode the materials are baked in (CONVERGED: rendered at --samples, default 64)",
+    )
+    parser.add_argument("--samples", type=int, help="EEVEE samples per pixel (default 1 for EXACT, 64 for CONVERGED)")
+    parser.add_argument(
         "--named", action="store_true", help="the named paints (addon.scenes.paints) instead of the randomised set"
     )
     args = parser.parse_args(argv)
@@ -156,6 +165,8 @@ def main(argv=None) -> int:
         paints = list(named().items())
         if args.out == default_out:
             args.out = default_out.with_name(f"eevee_fidelity-named-{version}.json")
+    if args.eevee_mode == "CONVERGED" and args.out == default_out:
+        args.out = default_out.with_name(f"eevee_fidelity-converged-{version}.json")
     else:
         paints = bench.random_paints(args.random, args.seed)
     import addon
@@ -163,8 +174,11 @@ def main(argv=None) -> int:
     addon.register()
     start = time.time()
     with tempfile.TemporaryDirectory() as tmp:
-        rows = measure(paints, args.luts or pathlib.Path(tmp), cycles=args.cycles)
-    report = {"blender": version, "seed": args.seed, "paints": {}}
+        samples = args.samples or (64 if args.eevee_mode == "CONVERGED" else 1)
+        rows = measure(
+            paints, args.luts or pathlib.Path(tmp), cycles=args.cycles, eevee_mode=args.eevee_mode, samples=samples
+        )
+    report = {"blender": version, "seed": args.seed, "eevee_mode": args.eevee_mode, "samples": samples, "paints": {}}
     figures = ("eevee", "eevee_fit", "bins", "cycles", "cycles_fit", "eevee_vs_cycles")
     for row in rows:
         report["paints"][row["label"]] = {
