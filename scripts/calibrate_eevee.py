@@ -47,8 +47,16 @@ from lut.render.closures import RETRO_ROUGHNESS, Closure  # noqa: E402
 
 #: The generated module of tables.
 MODULE = ROOT / "lut" / "render" / "eevee_tables.py"
-#: Pixels across one sphere's cell in the render.
-CELL = 96
+#: Pixels across one sphere's cell in the render: a sphere of radius 116
+#: pixels, so that with ``ERODE`` pixels left out at its silhouette the
+#: pixels still reach views 79° from the normal.
+CELL = 256
+#: Pixels next to a sphere's silhouette left out: EEVEE shades them brighter
+#: than the surface inside (Cycles does not).  Kept, as the first
+#: calibrations kept them, they were every pixel of views beyond 72° (a
+#: sphere of 43 pixels) and made sharp lobes' tables 8-10% too bright at
+#: θv = 75°, where a rough paint's grazing mirror dominates the measure.
+ERODE = 2
 #: Angles γ between light and view of the sweep (degrees).
 GAMMAS = tuple(range(0, 176, 5))
 
@@ -329,7 +337,7 @@ def measure(todo, per_render=25):
         samples = [[] for _ in batch]
         t0 = time.time()
         for gamma in GAMMAS:
-            for i, s in enumerate(scene.render(math.radians(gamma))):
+            for i, s in enumerate(scene.render(math.radians(gamma), erode=ERODE)):
                 samples[i].append(s)
         print(f"{len(batch)} closures, {len(GAMMAS)} renders, {time.time() - t0:.0f} s", flush=True)
         for s in samples:

@@ -67,7 +67,9 @@ def test_tables_are_interpolated_exactly_at_their_nodes():
     tl, tv, ph = eevee.THETA[i], eevee.THETA[j], eevee.PHI[k]
     got = eevee.evaluate(closure, tl, tv, ph)
     want = eevee.reference(closure, tl, tv, ph) * table[i, j, k]
-    np.testing.assert_allclose(got, np.maximum(want, 0.0), rtol=1e-12, atol=1e-300)
+    # (Nodes in radians are a rounding error off the grid: a cell clamped
+    # to 0 beside one that is not interpolates to 1e-15 of the peak.)
+    np.testing.assert_allclose(got, np.maximum(want, 0.0), rtol=1e-12, atol=1e-12 * want.max())
 
 
 def test_fit_table_recovers_the_table_its_interpolation_renders():
@@ -165,9 +167,9 @@ def test_tables_match_fresh_eevee_renders(oracle, closure):
     """The plane oracle rendered by EEVEE at a few geometries against the
     evaluator of the running Blender line: within 5% of the lobe's value, or
     2% of its peak where it is small; for sharp lobes, also beside the
-    mirror at grazing angles (within 12% there: what the tables' 5° cells
-    resolve of a lobe that sharp; binned tables, before the least-squares
-    fit, were 47% off at the first of these)."""
+    mirror at grazing angles (within 8% there, measured 0.96-1.07; the
+    first calibration's tables, binned and with silhouette pixels, were 47%
+    off at the first of these)."""
     import bpy
 
     from scripts.calibrate_eevee import closure_shader
@@ -185,5 +187,5 @@ def test_tables_match_fresh_eevee_renders(oracle, closure):
         for geometry in GRAZING_MIRROR:
             got = float(oracle.radiance(*geometry)[0])
             want = float(eevee.evaluate(closure, *geometry, version=version))
-            assert abs(got - want) <= 0.12 * want, (geometry, got, want)
+            assert abs(got - want) <= 0.08 * want, (geometry, got, want)
     assert math.isfinite(peak) and peak > 0
