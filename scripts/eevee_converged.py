@@ -146,13 +146,7 @@ def render(paints, directory, indices) -> None:
             nodes.wire(material, {"EEVEE": group}, render_bake.node_inputs(paint, fit.internal_reflectance))
             oracle.scene.eevee.taa_render_samples = 1
             got = np.array([oracle.radiance(*g) / oracle.irradiance for g in zip(tl, tv, ph, strict=True)])
-            evaluate = fitting.evaluator_for("EEVEE", CALIBRATION)
-            values = np.array([evaluate(c, tl, tv, ph) for c in fit.closures])
-            w = fitting.texture_weights(fit.weights, fit.cos_view, np.cos(tv))
-            if w.shape[-1] == 1:
-                predicted = np.einsum("kn,kcn,hc->nh", values, w[..., 0], amps)
-            else:
-                predicted = np.einsum("kn,kcnh,hc->nh", values, w, amps)
+            predicted = fit.radiance(amps, tl, tv, ph)
             rendered = measure.errors(got, model, tl)
             fitted = measure.errors(predicted, model, tl)
             noise = ""

@@ -394,3 +394,22 @@ def test_the_batched_spd_solver_is_numpys_solve():
     b = rng.normal(size=(30, 7))
     np.testing.assert_allclose(solve_spd(a, b), np.linalg.solve(a, b[..., None])[..., 0], rtol=1e-10, atol=1e-12)
     assert solve_spd(np.array([[4.0]]), np.array([2.0])) == pytest.approx([0.5])
+
+
+@pytest.mark.parametrize("target", ["CYCLES", "EEVEE"])
+def test_a_fits_radiance_is_what_its_reported_error_measures(tmp_path, target):
+    """``Fit.radiance`` (what the node group renders, by the target's closure
+    responses) against the model on the measure's grid gives the error the
+    fit reports, whole and over the grazing band, for a colour the fit was
+    not made at."""
+
+    paint = lut.Paint(n=1.55, rho=(0.6, 0.3, 0.05), single=0.1, g=0.3, slope=0.3, distribution="exponential")
+    table = baking.load_lut(baking.bake(paint, tmp_path))
+    fit = fitting.fit_lut(table, target, calibration=(5, 0) if target == "EEVEE" else None)
+    amps = table.amplitudes(paint)
+    tl, tv, ph = measure.points(smooth=False)
+    model = paint.brdf(tl, tv, ph) * np.cos(tl)[:, None]
+    whole, grazing = measure.errors(fit.radiance(amps, tl, tv, ph), model, tl)
+    assert whole == pytest.approx(fit.error(amps), rel=0.03, abs=0.002)
+    assert grazing == pytest.approx(fit.grazing_error(amps), rel=0.03, abs=0.002)
+    assert fit.radiance(amps, tl[:5], tv[:5], ph[:5]).shape == (5, 3)

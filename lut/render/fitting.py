@@ -264,6 +264,21 @@ class Fit:
         """The same over the grazing band (θl ≥ 60°)."""
         return reported_errors(self.grams(), amplitudes)[1]
 
+    def radiance(self, amplitudes, theta_l, theta_v, phi) -> np.ndarray:
+        """The RGB radiance per unit irradiance, (N, 3), that the node group
+        renders at geometries (θl, θv, φ) (1-D arrays) for a paint with these
+        amplitudes: the closures as the target draws them (``evaluator_for``:
+        EEVEE's measured responses for a calibrated fit) with the weights the
+        texture gives (nearest view column); a smooth type's mirror (a
+        delta) is not included.  What ``error`` measures against the model."""
+        tl, tv, ph = (np.ravel(np.asarray(a, dtype=float)) for a in (theta_l, theta_v, phi))
+        evaluate = evaluator_for(self.target, self.calibration)
+        values = np.array([evaluate(c, tl, tv, ph) for c in self.closures]).reshape(len(self.closures), tl.size)
+        comps = np.einsum("kn,kcnt->ntc", values, texture_weights(self.weights, self.cos_view, np.cos(tv)))
+        tiles = comps.shape[1]
+        amps = np.asarray(amplitudes, dtype=float)
+        return np.einsum("nkc,kc->nk", comps[:, [k if tiles == 3 else 0 for k in range(3)], :], amps)
+
     def grams(self) -> dict:
         """The Gram matrices the reported errors come from, as lists (what a
         material stores to show its errors for any colour): residual,
