@@ -165,10 +165,10 @@ def main(argv=None) -> int:
         paints = list(named().items())
         if args.out == default_out:
             args.out = default_out.with_name(f"eevee_fidelity-named-{version}.json")
-    if args.eevee_mode == "CONVERGED" and args.out == default_out:
-        args.out = default_out.with_name(f"eevee_fidelity-converged-{version}.json")
     else:
         paints = bench.random_paints(args.random, args.seed)
+    if args.eevee_mode == "CONVERGED" and args.out == default_out:
+        args.out = default_out.with_name(f"eevee_fidelity-converged-{version}.json")
     import addon
 
     addon.register()

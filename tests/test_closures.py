@@ -402,7 +402,6 @@ def test_a_fits_radiance_is_what_its_reported_error_measures(tmp_path, target):
     responses) against the model on the measure's grid gives the error the
     fit reports, whole and over the grazing band, for a colour the fit was
     not made at."""
-
     paint = lut.Paint(n=1.55, rho=(0.6, 0.3, 0.05), single=0.1, g=0.3, slope=0.3, distribution="exponential")
     table = baking.load_lut(baking.bake(paint, tmp_path))
     fit = fitting.fit_lut(table, target, calibration=(5, 0) if target == "EEVEE" else None)
