@@ -64,14 +64,32 @@ def test_converged_fits_trade_noise_for_error_only_where_it_pays(random_set):
 
 def test_converged_fits_of_sharp_exponential_paints_come_near_the_model(random_set):
     """The paints EEVEE's three exact closures draw worst (exponential
-    slopes 0.08-0.2, 20-25% off the model) come within 11% converged."""
+    slopes 0.05-0.25, 24-28% off the model): at least four of the five
+    keep a converged fit, each within 14% of the model (10-13%).  The one
+    that keeps its exact fit would gain in bias (a converged fit of it is
+    within 14% too) but not at the viewport's samples: its sharp lobe peaks at
+    the grazing mirror, where EEVEE seldom picks it, so its pixels there
+    scatter so widely that bias and spread together exceed what the
+    converged mode must gain (``CONVERGED_GAIN``)."""
+    kept = 0
     for paint, table, exact, converged in random_set:
         if paint.distribution != "exponential" or not 0.05 < paint.slope < 0.25:
             continue
         amps = table.amplitudes(paint)
         assert exact.error(amps) > 0.19
-        assert converged.error(amps) < 0.11, paint
-        assert eevee.samples_needed(converged, amps) <= 256
+        if not converged.sums_exactly:
+            kept += 1
+            assert converged.error(amps) < 0.14, paint
+            assert eevee.samples_needed(converged, amps) <= 256
+            continue
+        forced = fitting.fit_lut(
+            table, "EEVEE", calibration=CALIBRATION, eevee_mode="CONVERGED", converged_gain=np.inf
+        )  # fmt: skip
+        assert not forced.sums_exactly
+        assert forced.error(amps) < 0.14, paint
+        noisy = np.hypot(forced.error(amps), eevee.spread(forced, amps, eevee.VIEWPORT_SAMPLES))
+        assert noisy > fitting.CONVERGED_GAIN * exact.error(amps), paint
+    assert kept >= 4
 
 
 def _grams(fit):

@@ -54,8 +54,8 @@ def test_principled_facet_lobes_for_blender_4(registered, tmp_path):
 
 
 def test_eevee_converges_nearer_the_model_within_its_predicted_noise(registered, tmp_path):
-    """A sharp exponential paint (``random_paints(24)[6]``, slope 0.10),
-    which EEVEE's three exact closures draw 27% off the model: the scene's
+    """A sharp exponential paint (``random_paints(24)[21]``, slope 0.08),
+    which EEVEE's three exact closures draw 26% off the model: the scene's
     Converged mode renders it (the mean of 16 × 16 pixels at one sample,
     i.e. the mean over samples) less than 0.8 times as far from the model,
     and its per-pixel spread at the viewport's 16 samples, at the geometry
@@ -71,7 +71,7 @@ def test_eevee_converges_nearer_the_model_within_its_predicted_noise(registered,
     except RuntimeError as exc:  # no GPU context (no EGL/Mesa) on this machine
         pytest.skip(f"EEVEE cannot render here: {exc}")
     oracle.scene.render.resolution_x = oracle.scene.render.resolution_y = 16
-    paint = bench.random_paints(24)[6][1]
+    paint = bench.random_paints(24)[21][1]
     grid = (np.radians([30, 60, 75]), np.radians([35, 65, 75]), np.radians([0, 90]))
     errors = {}
     for mode in ("EXACT", "CONVERGED"):
@@ -81,7 +81,7 @@ def test_eevee_converges_nearer_the_model_within_its_predicted_noise(registered,
         errors[mode] = scenes.oracle_errors(oracle, paint, grid)[0]
     fit = result.fits["EEVEE"]
     assert not fit.sums_exactly
-    assert errors["EXACT"] > 0.2  # 27.3%
+    assert errors["EXACT"] > 0.2  # 30.1%; converged 15.1% (5.2)
     assert errors["CONVERGED"] < 0.8 * errors["EXACT"]
     amps = result.lut.amplitudes(paint)
     points = scenes.grid_points(paint, grid)

@@ -647,6 +647,7 @@ def fit_lut(
     eevee_mode=DEFAULT_EEVEE_MODE,
     converged_budget=CONVERGED_BUDGET,
     converged_extra=CONVERGED_EXTRA,
+    converged_gain=CONVERGED_GAIN,
 ) -> Fit:
     """Fit a loaded LUT (``lut.lutfiles.baking.LUT``) onto the closures of a render
     target (module docstring).  ``budget``, ``extra_budget``: closures per
@@ -659,7 +660,8 @@ def fit_lut(
     ``eevee_mode``: for EEVEE, "EXACT" or "CONVERGED" (``EEVEE_MODES``):
     where the exact fit misses a goal, a converged one of up to
     ``converged_budget`` closures (+ ``converged_extra``) is fitted too and
-    the one nearer the goals kept."""
+    kept where its shortfall, viewport noise counted in, is below
+    ``converged_gain`` times the exact fit's (``CONVERGED_GAIN``)."""
     target = closures.validate_target(target)
     eevee_mode = validate_eevee_mode(eevee_mode) if target == "EEVEE" else "EXACT"
     evaluate = evaluator_for(target, calibration)
@@ -711,7 +713,7 @@ def fit_lut(
             lut, target, evaluate, wide, theta_v, theta_l, phi, row_w, model,
             int(converged_budget), int(converged_extra), False, noise,
         )  # fmt: skip
-        if fitted[-1] < CONVERGED_GAIN * best[-1]:
+        if fitted[-1] < float(converged_gain) * best[-1]:
             best = fitted
     basis_kept, weights, whole, band, _ = best
     n = reference_index(type_dict["n"])
