@@ -332,33 +332,34 @@ class Paint:
 
     # ------------------------------------------------------------------ evaluation
 
-    def _geometry(self, ti, ts, ps, n, single_nodes, diffuse_nodes, every_term=False):
-        """M00 of each term with unit weights (the diffuse one at ρ = 1) and
-        the interface's r̄.  Zero-weight terms are not computed unless
-        ``every_term``; smooth paints never run the rough models."""
+    def _geometry(self, ti, ts, ps, n, single_nodes, diffuse_nodes, every_term=False, mueller=False):
+        """M00 of each term (its whole Mueller matrix with ``mueller``) with
+        unit weights (the diffuse one at ρ = 1) and the interface's r̄.
+        Zero-weight terms are not computed unless ``every_term``; smooth
+        paints never run the rough models."""
         out = {}
         rough = self.slope > 0.0
         if (self.facet > 0.0 or every_term) and rough:
             out["facet"] = models.facet_reflection(
-                ti, ts, ps, n=n, slope=self.slope, distribution=self.distribution, mueller=False
+                ti, ts, ps, n=n, slope=self.slope, distribution=self.distribution, mueller=mueller
             )
         if self.has_single or every_term:
             if rough:
                 out["single"] = models.rough_single(
                     ti, ts, ps, n=n, g=self.g, slope=self.slope, distribution=self.distribution,
-                    mueller=False, nodes=single_nodes,
+                    mueller=mueller, nodes=single_nodes,
                 )  # fmt: skip
             else:
-                out["single"] = models.smooth_single(ti, ts, ps, n=n, g=self.g, mueller=False)
+                out["single"] = models.smooth_single(ti, ts, ps, n=n, g=self.g, mueller=mueller)
         if self.has_diffuse or every_term:
             if rough:
                 out["diffuse"] = models.rough_diffuse(
                     ti, ts, ps, n=n, rho=1.0, slope=self.slope, distribution=self.distribution,
-                    mueller=False, nodes=diffuse_nodes,
+                    mueller=mueller, nodes=diffuse_nodes,
                 )  # fmt: skip
                 out["rbar"] = models.rough_internal_reflectance(n, self.slope, self.distribution, diffuse_nodes)
             else:
-                out["diffuse"] = models.smooth_diffuse(ti, ts, ps, n=n, rho=1.0, mueller=False)
+                out["diffuse"] = models.smooth_diffuse(ti, ts, ps, n=n, rho=1.0, mueller=mueller)
                 out["rbar"] = models.internal_reflectance(n)
         return out
 
@@ -396,6 +397,21 @@ class Paint:
             for key, weight in (("facet", w_facet), ("single", w_single), ("diffuse", w_diffuse)):
                 if key in geo:
                     out += geo[key][..., None] * weight
+        return out
+
+    def mueller(self, theta_i, theta_s, phi_s, *, single_nodes=SINGLE_NODES, diffuse_nodes=DIFFUSE_NODES):
+        """Mueller BRDF [sr⁻¹] of all non-delta terms per RGB channel, shape
+        broadcast(angles) + (3, 4, 4), in SCATMECH's s/p bases (``lut.models``,
+        docs/models.md): the models' Mueller matrices weighted as in ``brdf``,
+        whose values are its [..., 0, 0] elements."""
+        ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s, broadcast=False)
+        out = np.zeros(np.broadcast_shapes(ti.shape, ts.shape, ps.shape) + (3, 4, 4))
+        for n, band in self._bands():
+            geo = self._geometry(ti, ts, ps, n, single_nodes, diffuse_nodes, mueller=True)
+            w_facet, w_single, w_diffuse = self._weights(geo.get("rbar", 0.0), band)
+            for key, weight in (("facet", w_facet), ("single", w_single), ("diffuse", w_diffuse)):
+                if key in geo:
+                    out += geo[key][..., None, :, :] * np.asarray(weight, dtype=float)[:, None, None]
         return out
 
     def specular_reflectance(self, theta_i):
