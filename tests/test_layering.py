@@ -1,7 +1,7 @@
 """Dependencies point one way.  ``lut`` is pure Python over numpy,
 OpenImageIO and colour-science: it never imports bpy or the add-on.  Inside
 ``lut`` the layers import only layers before them (models -> colour ->
-paint -> LUT files -> render -> the top-level faces), and the add-on's
+paint -> LUT files -> polarized -> render -> the top-level faces), and the add-on's
 modules import each other without a circle."""
 
 import ast
@@ -15,7 +15,7 @@ ADDON = ROOT / "addon"
 
 #: lut's layers, in the order they may import each other ("" is the top:
 #: lut/__init__.py, __main__, examples, bench, figures and the former names).
-LAYERS = ("models", "colour", "paint", "lutfiles", "render", "")
+LAYERS = ("models", "colour", "paint", "lutfiles", "polarized", "render", "")
 
 
 def _imports(path: pathlib.Path, root: pathlib.Path):

@@ -1,0 +1,102 @@
+"""A polarization basis continuous over the hemisphere, and the change into
+it from SCATMECH's s/p bases.
+
+SCATMECH (and ``lut.models``, docs/models.md) refers a ray of propagation
+direction k to s = ẑ×k/|ẑ×k|, p = k×s.  Along the normal that basis has no
+value of its own: the models take the limit along the ray's azimuth, so a
+Mueller matrix turns by twice the azimuth as the exit direction circles the
+pole, and a table interpolating across θs = 0 mixes matrices referred to
+different bases.
+
+The *transported* basis has no such point: its s vector is the global x̂
+carried from the pole nearest k (+ẑ for rays leaving the surface, -ẑ for
+rays arriving at it) to k by the rotation about ẑ×k (parallel transport
+along the meridian), p = k×s.  With k = (x, y, z) and σ = sign(z) (+1 at
+z = 0):
+
+    s = (1 - σ x²/(σ + z), -σ x y/(σ + z), -σ x),
+
+T. Duff et al., "Building an Orthonormal Basis, Revisited", JCGT 6(1), 2017,
+Listing 3 (the first vector); Mitsuba 3 takes the same vector as its Stokes
+basis of a direction (``mueller::stokes_basis``).  It is smooth on each
+open hemisphere, poles included.
+
+Changing the basis of one ray rotates its Stokes vector: with
+s' = cos ψ s + sin ψ p (p' = k×s'), the Jones components turn by
+R(ψ) = [[cos ψ, sin ψ], [-sin ψ, cos ψ]] and the Stokes vector by
+L(ψ) = M(R(ψ)) (``stokes_rotation``), so a Mueller matrix M referred to the
+s/p bases is, in the transported ones, L(ψ_s) · M · L(ψ_i)⁻¹ (the rule of
+R. A. Chipman et al., "Polarized Light and Optical Systems", CRC 2018,
+Sec. 6.4).  M00 is unchanged."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..models import _validate, geometry
+
+
+def transported_basis(k):
+    """(s, p) of unit propagation directions k (..., 3) in the transported
+    basis (module docstring): each (..., 3)."""
+    k = np.asarray(k, dtype=float)
+    x, y, z = k[..., 0], k[..., 1], k[..., 2]
+    sign = np.where(z >= 0.0, 1.0, -1.0)
+    a = -1.0 / (sign + z)
+    s = np.stack((1.0 + sign * x * x * a, sign * x * y * a, -sign * x), axis=-1)
+    return s, geometry.cross(k, s)
+
+
+def stokes_rotation(psi):
+    """L(ψ) (..., 4, 4): the change of a Stokes vector (I, Q, U, V), Q = I_s - I_p,
+    when its basis turns by ψ about the ray (s' = cos ψ s + sin ψ p)."""
+    psi = np.asarray(psi, dtype=float)
+    c, s = np.cos(2.0 * psi), np.sin(2.0 * psi)
+    out = np.zeros(psi.shape + (4, 4))
+    out[..., 0, 0] = out[..., 3, 3] = 1.0
+    out[..., 1, 1] = out[..., 2, 2] = c
+    out[..., 1, 2] = s
+    out[..., 2, 1] = -s
+    return out
+
+
+def _turn(k, s_scatmech, p_scatmech):
+    """ψ from the s/p basis (s, p) of k to its transported basis."""
+    s_t, _ = transported_basis(k)
+    return np.arctan2(geometry.dot(s_t, p_scatmech), geometry.dot(s_t, s_scatmech))
+
+
+def _scatmech_exit_basis(theta_s, phi_s):
+    """SCATMECH's s/p basis of the exit direction, with the models' limit
+    along φs at θs = 0 (docs/models.md): s = (-sin φs, cos φs, 0)."""
+    k = geometry.scattered(theta_s, phi_s)
+    s = np.stack((-np.sin(phi_s), np.cos(phi_s), np.zeros_like(phi_s)), axis=-1)
+    return k, s, geometry.cross(k, s)
+
+
+def _scatmech_incident_basis(theta_i):
+    """SCATMECH's s/p basis of the incident direction (source at azimuth π,
+    k_i = (sin θi, 0, -cos θi)): s = ŷ for every θi, the normal included."""
+    k = np.stack((np.sin(theta_i), np.zeros_like(theta_i), -np.cos(theta_i)), axis=-1)
+    s = np.broadcast_to(np.array([0.0, 1.0, 0.0]), k.shape)
+    return k, s, geometry.cross(k, s)
+
+
+def mueller_in_transported_basis(mueller, theta_i, theta_s, phi_s):
+    """A Mueller matrix (..., 4, 4), or per channel (..., C, 4, 4), referred
+    to SCATMECH's s/p bases of the incident and exit rays at model angles
+    (radians; the source at azimuth π), referred instead to their
+    transported bases: L(ψ_s) · M · L(ψ_i)⁻¹ (module docstring)."""
+    ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s)
+    mueller = np.asarray(mueller, dtype=float)
+    shape = ti.shape
+    if mueller.shape[: len(shape)] != shape or mueller.shape[-2:] != (4, 4):
+        raise ValueError(
+            f"mueller must have shape angles + (4, 4) or angles + (C, 4, 4) with angles {shape}, got {mueller.shape}"
+        )
+    psi_i = _turn(*_scatmech_incident_basis(ti))
+    psi_s = _turn(*_scatmech_exit_basis(ts, ps))
+    extra = mueller.ndim - len(shape) - 2
+    out_l = stokes_rotation(psi_s).reshape(shape + (1,) * extra + (4, 4))
+    in_l = stokes_rotation(-psi_i).reshape(shape + (1,) * extra + (4, 4))
+    return out_l @ mueller @ in_l
