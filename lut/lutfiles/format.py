@@ -288,7 +288,18 @@ def read_exr(path) -> np.ndarray:
     """The float pixels (height, width, channels) of an EXR image written by
     ``write_exr`` (closure weights files), verified against its
     ``paintlut:hash`` and finite; raises LUTError."""
-    pixels, attrs = _read_image(path, ("paintlut:hash",), prefix="paintlut:")
+    return read_exr_attributes(path)[0]
+
+
+def read_exr_attributes(path, what="file", expect=None):
+    """(pixels, {name: value} of its ``paintlut:`` attributes but the hash)
+    of an EXR image written by ``write_exr``, verified as ``read_exr``
+    verifies it; raises LUTError naming the file (``what`` it is), first
+    where an attribute of ``expect`` ({name: value}) has another value."""
+    pixels, attrs = _read_image(path, ("paintlut:hash",), what, prefix="paintlut:")
+    for name, value in (expect or {}).items():
+        if attrs.get(name) != value:
+            raise LUTError(f"{path}: not a {what} of this version (its {name} is {attrs.get(name)!r}, not {value!r})")
     stored = attrs.pop("paintlut:hash")
     if not isinstance(stored, str):
         raise LUTError(f"{path}: no paintlut:hash (written by an older version, or altered): bake it again")
@@ -296,7 +307,7 @@ def read_exr(path) -> np.ndarray:
         raise LUTError(f"{path}: content does not match its hash (altered or damaged file)")
     if not np.all(np.isfinite(pixels)):
         raise LUTError(f"{path}: pixel values are not finite")
-    return pixels
+    return pixels, attrs
 
 
 def read_header(path) -> dict:

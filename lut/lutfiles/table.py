@@ -101,22 +101,30 @@ def interpolate(table, theta_i, theta_s, phi_s):
         np.clip(td / HALF_PI, 0.0, 1.0) * (n_d - 1),
         np.sqrt(np.clip(th / HALF_PI, 0.0, 1.0)) * (n_u - 1),
     )
+    out = trilinear(table, coords)
+    up = (ti < HALF_PI) & (ts < HALF_PI)
+    cos2 = np.where(up, np.cos(ti) * np.cos(ts), 1.0)
+    return np.where(up[..., None], out / cos2[..., None], 0.0)
+
+
+def trilinear(table, coords):
+    """Trilinear interpolation of a table (N_a, N_b, N_c, C) at fractional
+    node coordinates (a, b, c) (each of one shape, within the table):
+    returns that shape + (C,)."""
     lo, frac = [], []
-    for c, size in zip(coords, (n_p, n_d, n_u), strict=True):
+    for c, size in zip(coords, table.shape[:3], strict=True):
         i = np.minimum(np.floor(c).astype(np.intp), max(size - 2, 0))
         lo.append(i)
         frac.append((c - i)[..., None] if size > 1 else np.zeros(c.shape + (1,)))
-    out = np.zeros(ti.shape + (table.shape[-1],))
+    out = np.zeros(np.shape(coords[0]) + (table.shape[-1],))
     for dp in (0, 1):
         wp = frac[0] if dp else 1.0 - frac[0]
         for dd in (0, 1):
             wd = frac[1] if dd else 1.0 - frac[1]
             for du in (0, 1):
                 wu = frac[2] if du else 1.0 - frac[2]
-                ip = np.minimum(lo[0] + dp, n_p - 1)
-                idd = np.minimum(lo[1] + dd, n_d - 1)
-                iu = np.minimum(lo[2] + du, n_u - 1)
+                ip = np.minimum(lo[0] + dp, table.shape[0] - 1)
+                idd = np.minimum(lo[1] + dd, table.shape[1] - 1)
+                iu = np.minimum(lo[2] + du, table.shape[2] - 1)
                 out += wp * wd * wu * table[ip, idd, iu]
-    up = (ti < HALF_PI) & (ts < HALF_PI)
-    cos2 = np.where(up, np.cos(ti) * np.cos(ts), 1.0)
-    return np.where(up[..., None], out / cos2[..., None], 0.0)
+    return out

@@ -217,33 +217,41 @@ class Paint:
             float(self.index_at(REFERENCE_WAVELENGTH)), self.slope, self.distribution, tuple(diffuse_nodes)
         )
 
-    def components(self, theta_i, theta_s, phi_s, *, single_nodes=SINGLE_NODES, diffuse_nodes=DIFFUSE_NODES):
+    def components(
+        self, theta_i, theta_s, phi_s, *, single_nodes=SINGLE_NODES, diffuse_nodes=DIFFUSE_NODES, mueller=False
+    ):
         """The colour-independent angular components ``COMPONENTS`` (M00,
         sr⁻¹), shape broadcast(angles) + (T, 3): T = 1 for a non-dispersive
         paint (the same for every channel), T = 3 (one per RGB channel) for a
         dispersive one, whose bands are combined per channel with the
         paint's own weights and divided by ``amplitudes``.  The BRDF is
         Σ_c amplitudes[ch, c] · components[..., ch or 0, c]; a smooth paint's
-        facet component is 0 (its mirror is a delta)."""
+        facet component is 0 (its mirror is a delta).  ``mueller``: each
+        component's whole Mueller matrix (SCATMECH's bases, ``mueller``),
+        shape broadcast(angles) + (T, 3, 4, 4)."""
         ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s, broadcast=False)
         shape = np.broadcast_shapes(ti.shape, ts.shape, ps.shape)
+        element = (4, 4) if mueller else ()
         if not self.dispersive:
-            geo = self._geometry(ti, ts, ps, self.n, single_nodes, diffuse_nodes, every_term=True)
-            out = np.zeros(shape + (1, 3))
+            geo = self._geometry(ti, ts, ps, self.n, single_nodes, diffuse_nodes, every_term=True, mueller=mueller)
+            out = np.zeros(shape + (1, 3) + element)
             for c, key in enumerate(COMPONENTS):
                 if key in geo:
-                    out[..., 0, c] = geo[key]
+                    out[..., 0, c, *([slice(None)] * len(element))] = geo[key]
             return out
-        out = np.zeros(shape + (3, 3))
+        out = np.zeros(shape + (3, 3) + element)
         total = np.zeros((3, 3))
+        pad = (None,) * len(element)
         for n, band in self._bands():
-            geo = self._geometry(ti, ts, ps, n, single_nodes, diffuse_nodes, every_term=True)
+            geo = self._geometry(ti, ts, ps, n, single_nodes, diffuse_nodes, every_term=True, mueller=mueller)
             weights = self._weights(geo["rbar"], band)
             for c, key in enumerate(COMPONENTS):
                 if key in geo:
-                    out[..., :, c] += geo[key][..., None] * weights[c]
+                    out[..., :, c, *([slice(None)] * len(element))] += (
+                        geo[key][..., None, *([slice(None)] * len(element))] * weights[c][(slice(None), *pad)]
+                    )
                     total[:, c] += weights[c]
-        return out / np.where(total > 0, total, 1.0)
+        return out / np.where(total > 0, total, 1.0)[(..., *pad)]
 
     def amplitudes(self, diffuse_nodes=DIFFUSE_NODES) -> np.ndarray:
         """The weights of the components per RGB channel, (3 channels, 3
