@@ -60,43 +60,61 @@ def stokes_rotation(psi):
     return out
 
 
-def _turn(k, s_scatmech, p_scatmech):
-    """ψ from the s/p basis (s, p) of k to its transported basis."""
-    s_t, _ = transported_basis(k)
-    return np.arctan2(geometry.dot(s_t, p_scatmech), geometry.dot(s_t, s_scatmech))
+def turn(k, s_from, p_from, s_to):
+    """ψ from a basis (s_from, p_from) of rays k to another (s_to, k×s_to):
+    s_to = cos ψ s_from + sin ψ p_from."""
+    return np.arctan2(geometry.dot(s_to, p_from), geometry.dot(s_to, s_from))
 
 
-def _scatmech_exit_basis(theta_s, phi_s):
-    """SCATMECH's s/p basis of the exit direction, with the models' limit
-    along φs at θs = 0 (docs/models.md): s = (-sin φs, cos φs, 0)."""
-    k = geometry.scattered(theta_s, phi_s)
-    s = np.stack((-np.sin(phi_s), np.cos(phi_s), np.zeros_like(phi_s)), axis=-1)
-    return k, s, geometry.cross(k, s)
-
-
-def _scatmech_incident_basis(theta_i):
-    """SCATMECH's s/p basis of the incident direction (source at azimuth π,
-    k_i = (sin θi, 0, -cos θi)): s = ŷ for every θi, the normal included."""
-    k = np.stack((np.sin(theta_i), np.zeros_like(theta_i), -np.cos(theta_i)), axis=-1)
-    s = np.broadcast_to(np.array([0.0, 1.0, 0.0]), k.shape)
-    return k, s, geometry.cross(k, s)
-
-
-def mueller_in_transported_basis(mueller, theta_i, theta_s, phi_s):
+def refer(mueller, psi_i, psi_s):
     """A Mueller matrix (..., 4, 4), or per channel (..., C, 4, 4), referred
-    to SCATMECH's s/p bases of the incident and exit rays at model angles
-    (radians; the source at azimuth π), referred instead to their
-    transported bases: L(ψ_s) · M · L(ψ_i)⁻¹ (module docstring)."""
-    ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s)
+    to new bases of its incident and exit rays, turned by ψ_i and ψ_s (each
+    of the angles' shape): L(ψ_s) · M · L(-ψ_i)."""
     mueller = np.asarray(mueller, dtype=float)
-    shape = ti.shape
-    if mueller.shape[: len(shape)] != shape or mueller.shape[-2:] != (4, 4):
+    psi_i, psi_s = np.broadcast_arrays(np.asarray(psi_i, dtype=float), np.asarray(psi_s, dtype=float))
+    shape = psi_i.shape
+    if mueller.shape[: len(shape)] != shape or mueller.shape[-2:] != (4, 4) or mueller.ndim > len(shape) + 3:
         raise ValueError(
             f"mueller must have shape angles + (4, 4) or angles + (C, 4, 4) with angles {shape}, got {mueller.shape}"
         )
-    psi_i = _turn(*_scatmech_incident_basis(ti))
-    psi_s = _turn(*_scatmech_exit_basis(ts, ps))
-    extra = mueller.ndim - len(shape) - 2
-    out_l = stokes_rotation(psi_s).reshape(shape + (1,) * extra + (4, 4))
-    in_l = stokes_rotation(-psi_i).reshape(shape + (1,) * extra + (4, 4))
-    return out_l @ mueller @ in_l
+    extra = (1,) * (mueller.ndim - len(shape) - 2)
+    return (
+        stokes_rotation(psi_s).reshape(shape + extra + (4, 4))
+        @ mueller
+        @ stokes_rotation(-psi_i).reshape(shape + extra + (4, 4))
+    )
+
+
+def about_normal(v, angle):
+    """Vectors v (..., 3) turned by ``angle`` about ẑ."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.stack((c * v[..., 0] - s * v[..., 1], s * v[..., 0] + c * v[..., 1], v[..., 2]), axis=-1)
+
+
+def scatmech_bases(theta_i, theta_s, phi_s):
+    """SCATMECH's s/p bases at model angles (the source at azimuth π):
+    ((k_i, s_i, p_i), (k_s, s_s, p_s)).  k_i = (sin θi, 0, -cos θi) and
+    s_i = ŷ for every θi, the normal included (the source's azimuth is
+    fixed); s_s = (-sin φs, cos φs, 0), the models' limit along φs at
+    θs = 0 (docs/models.md)."""
+    k_i = np.stack((np.sin(theta_i), np.zeros_like(theta_i), -np.cos(theta_i)), axis=-1)
+    s_i = np.broadcast_to(np.array([0.0, 1.0, 0.0]), k_i.shape)
+    k_s = geometry.scattered(theta_s, phi_s)
+    s_s = np.stack((-np.sin(phi_s), np.cos(phi_s), np.zeros_like(phi_s)), axis=-1)
+    return (k_i, s_i, geometry.cross(k_i, s_i)), (k_s, s_s, geometry.cross(k_s, s_s))
+
+
+def mueller_in_transported_basis(mueller, theta_i, theta_s, phi_s, frame=0.0):
+    """A Mueller matrix (..., 4, 4), or per channel (..., C, 4, 4), referred
+    to SCATMECH's s/p bases of the incident and exit rays at model angles
+    (radians; the source at azimuth π), referred instead to their
+    transported bases: L(ψ_s) · M · L(ψ_i)⁻¹ (module docstring).  The
+    transported bases are those of a frame turned by ``frame`` (radians,
+    broadcast with the angles) about the normal from the models' (in which
+    the source lies at azimuth π + frame)."""
+    ti, ts, ps, frame = np.broadcast_arrays(*_validate.angles(theta_i, theta_s, phi_s), np.asarray(frame, dtype=float))
+    psi = []
+    for k, s_ray, p_ray in scatmech_bases(ti, ts, ps):
+        k, s_ray, p_ray = (about_normal(v, frame) for v in (k, s_ray, p_ray))
+        psi.append(turn(k, s_ray, p_ray, transported_basis(k)[0]))
+    return refer(mueller, *psi)

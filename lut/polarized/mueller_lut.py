@@ -1,0 +1,289 @@
+"""The Mueller LUT of a paint type: each colour-free component's whole
+Mueller matrix (``lut.Paint.components(..., mueller=True)``: facet, single
+scattering, diffuse at ρ = 1; the smooth interface's mirror stays a delta),
+tabulated in the transported polarization bases (``lut.polarized.basis``),
+written and cached like the M00 LUT (``lut.lutfiles``).
+
+**Parameterization.** Rusinkiewicz's half/difference angles as in the M00
+LUT (``lut.lutfiles.angles``, ``lut.lutfiles.table``): θh = (π/2)u², θd
+uniform, and each node is placed in the *half frame*, the frame whose x
+axis lies under the half vector (φh = 0).  The incident and exit rays of a
+node are smooth functions of (u, θd, φd) there, and so are their
+transported bases: every element is smooth over the table, the normal
+included, where SCATMECH's bases turn with the azimuth.  Only mirror
+symmetry folds φd: the mirror image of a configuration in the plane
+through the normal and the half vector has the matrix D·M·D, D = diag(1, 1,
+-1, -1) (U and V change sign: the transported basis's s is mirrored with
+its ray, p = k×s is mirrored and reversed), so φd runs over [0, π].
+(Reciprocity would fold it to [0, π/2] but exchanges the rays, whose
+bases differ.)  Nodes below the horizon hold the matrix at polar angles
+clamped to ``HORIZON_CLAMP``, as in the M00 LUT, and G = M·cos θi·cos θs is
+stored per element, so cells straddling the horizon interpolate smoothly.
+
+**Lookup** (``MuellerLUT.components``): the geometry is taken into its
+half frame, its φd folded (and D applied), the 16 elements interpolated
+trilinearly and divided by cos θi cos θs, and the matrix turned from the
+half frame's transported bases into those of the models' frame (the
+source at azimuth π) by one Stokes rotation per ray.
+
+**Image layout.** float32, three channels (the components), width N_u,
+height T·16·N_φd·N_θd: tile t (1, or 3 for a dispersive paint), element
+(i, j) of the matrix in block 4i + j, then N_φd blocks of (θh, θd) rows,
+as the M00 LUT's tiles.  Header: ``paintlut:mueller`` (this format's
+version), ``paintlut:meta`` (JSON: the type, resolution, quadrature, basis,
+parameterization), ``paintlut:key`` and ``paintlut:hash``.
+"""
+
+from __future__ import annotations
+
+import json
+import pathlib
+
+import numpy as np
+
+from ..lutfiles import baking, table
+from ..lutfiles import format as lutfile
+from ..models import _validate
+from ..models.rough import DIFFUSE_NODES
+from ..paint.core import COMPONENTS, Paint
+from . import basis
+
+#: Version of the Mueller LUT's file format.
+MUELLER_FORMAT = 1
+#: (N_u, N_θd, N_φd) by default: the M00 LUT's spacing, with φd over [0, π].
+DEFAULT_RESOLUTION = (64, 32, 32)
+PARAMETERIZATION = (
+    "rusinkiewicz in the half frame (theta_h=pi/2*u^2, theta_d, phi_d in [0, pi]); "
+    "G = M cos(theta_i) cos(theta_s) per element"
+)
+BASIS = "transported: s = x carried from the nearest pole along the meridian, p = k x s (Duff et al. 2017)"
+HALF_PI = np.pi / 2
+#: D of the mirror fold: U and V change sign.
+MIRROR = np.diag([1.0, 1.0, -1.0, -1.0])
+
+
+def describe(
+    paint: Paint, resolution=DEFAULT_RESOLUTION, single_nodes=baking.BAKE_SINGLE_NODES, diffuse_nodes=DIFFUSE_NODES
+) -> dict:
+    """The meta of a Mueller bake: the M00 LUT's (``lut.lutfiles.baking.describe``)
+    with this table's parameterization and basis."""
+    meta = baking.describe(paint, resolution, single_nodes, diffuse_nodes)
+    return {**meta, "format": MUELLER_FORMAT, "parameterization": PARAMETERIZATION, "basis": BASIS}
+
+
+def mueller_lut_path(paint: Paint, directory, **options) -> pathlib.Path:
+    """Where ``bake_mueller`` puts (or finds) the Mueller LUT of a paint's type."""
+    return pathlib.Path(directory) / f"paintmueller-{lutfile.cache_key(describe(paint, **options))[:24]}.exr"
+
+
+def _axes(resolution):
+    n_u, n_d, n_p = resolution
+    u = np.linspace(0.0, 1.0, n_u)
+    return HALF_PI * u * u, np.linspace(0.0, HALF_PI, n_d), np.linspace(0.0, np.pi, n_p)
+
+
+def _half_frame_rays(theta_h, theta_d, phi_d):
+    """Unit vectors towards the light and the viewer in the half frame
+    (Rusinkiewicz: ω = R_y(θh)·d, d and its mirror about the half vector)."""
+    theta_h, theta_d, phi_d = np.broadcast_arrays(theta_h, theta_d, phi_d)
+    d = np.stack((np.sin(theta_d) * np.cos(phi_d), np.sin(theta_d) * np.sin(phi_d), np.cos(theta_d)), -1)
+    c, s = np.cos(theta_h), np.sin(theta_h)
+
+    def rot(v):
+        return np.stack((c * v[..., 0] + s * v[..., 2], v[..., 1], -s * v[..., 0] + c * v[..., 2]), -1)
+
+    return rot(d), rot(d * np.array([-1.0, -1.0, 1.0]))
+
+
+def node_geometry(resolution):
+    """Per node (N_φd, N_θd, N_u): model angles (θi, θs, φs), polar angles
+    clamped to ``table.HORIZON_CLAMP``, and the half frame's turn from the
+    models' frame (the light's azimuth there minus π)."""
+    th, td, pd = _axes(resolution)
+    wi, wo = _half_frame_rays(th[None, None, :], td[None, :, None], pd[:, None, None])
+    light = np.arctan2(wi[..., 1], wi[..., 0])
+    view = np.arctan2(wo[..., 1], wo[..., 0])
+    ti = np.minimum(np.arccos(np.clip(wi[..., 2], -1.0, 1.0)), table.HORIZON_CLAMP)
+    ts = np.minimum(np.arccos(np.clip(wo[..., 2], -1.0, 1.0)), table.HORIZON_CLAMP)
+    ps = np.mod(view - light + 2 * np.pi, 2 * np.pi) - np.pi
+    return ti, ts, ps, light - np.pi
+
+
+def bake_mueller(
+    paint: Paint,
+    directory,
+    *,
+    resolution=DEFAULT_RESOLUTION,
+    single_nodes=baking.BAKE_SINGLE_NODES,
+    diffuse_nodes=DIFFUSE_NODES,
+    force=False,
+    chunk=2048,
+) -> pathlib.Path:
+    """Bake the Mueller matrices of a paint's type into a Mueller LUT file
+    in ``directory`` and return its path; a valid cached file is returned
+    as it is unless ``force``.  Written atomically (``lut.lutfiles.files``)."""
+    if not isinstance(paint, Paint):
+        raise ValueError(f"paint must be a lut.Paint, got {type(paint).__name__}")
+    meta = describe(paint, resolution, single_nodes, diffuse_nodes)
+    key = lutfile.cache_key(meta)
+    path = pathlib.Path(directory) / f"paintmueller-{key[:24]}.exr"
+    if path.exists() and not force:
+        try:
+            if load_mueller_lut(path).key == key:  # loading verifies the content hash
+                return path
+        except lutfile.LUTError:
+            pass  # damaged or foreign: bake it again
+    return _bake(paint, path, meta, chunk)
+
+
+def _bake(paint, path, meta, chunk=2048):
+    ti, ts, ps, frame = (a.ravel() for a in node_geometry(tuple(meta["resolution"])))
+    opts = {
+        "single_nodes": tuple(meta.get("single_nodes", baking.BAKE_SINGLE_NODES)),
+        "diffuse_nodes": tuple(meta.get("diffuse_nodes", DIFFUSE_NODES)),
+    }
+    tiles = meta["tiles"]
+    out = np.empty((ti.size, tiles, len(COMPONENTS), 4, 4))
+    for start in range(0, ti.size, chunk):
+        sl = slice(start, start + chunk)
+        m = paint.components(ti[sl], ts[sl], ps[sl], mueller=True, **opts)  # (n, T, 3, 4, 4), SCATMECH bases
+        m = basis.mueller_in_transported_basis(m.reshape(m.shape[0], -1, 4, 4), ti[sl], ts[sl], ps[sl], frame[sl])
+        out[sl] = (
+            m.reshape(-1, tiles, len(COMPONENTS), 4, 4) * (np.cos(ti[sl]) * np.cos(ts[sl]))[:, None, None, None, None]
+        )
+    n_u, n_d, n_p = meta["resolution"]
+    grid = out.reshape(n_p, n_d, n_u, tiles, len(COMPONENTS), 16)
+    image = np.ascontiguousarray(np.transpose(grid, (3, 5, 0, 1, 2, 4)).reshape(-1, n_u, len(COMPONENTS)), np.float32)
+    if not np.all(np.isfinite(image)):
+        raise ValueError(
+            "the baked Mueller LUT has values that are not finite: the paint's parameters are outside what a "
+            "LUT can hold (for example a slope far below 0.001; use 0 for a smooth surface)"
+        )
+    meta_json = lutfile.canonical_json(meta)
+    attributes = {
+        "paintlut:mueller": MUELLER_FORMAT,
+        "paintlut:meta": meta_json,
+        "paintlut:key": lutfile.cache_key(meta),
+    }
+    return lutfile.write_exr(path, image, attributes)
+
+
+class MuellerLUT:
+    """A loaded Mueller LUT: ``components(θi, θs, φs)`` the interpolated
+    Mueller matrices of the components, ``mueller(θi, θs, φs, paint)`` a
+    paint's per RGB channel (both in the transported bases of the models'
+    frame, ``lut.polarized.mueller_in_transported_basis``).  ``data`` is
+    (T, 16, N_φd, N_θd, N_u, 3): G = M·cos θi·cos θs per element and
+    component."""
+
+    def __init__(self, data, meta, path=None, key=""):
+        self.data = data
+        self.meta = meta
+        self.path = path
+        self.key = key or lutfile.cache_key(meta)
+        tiles = data.shape[0]
+        # (N_φd, N_θd, N_u, T·3·16) for one trilinear pass over every element.
+        self._flat = np.ascontiguousarray(np.transpose(data, (2, 3, 4, 0, 5, 1)).reshape(data.shape[2:5] + (-1,)))
+        self._tiles = tiles
+
+    @property
+    def internal_reflectance(self) -> float:
+        return float(self.meta["internal_reflectance"])
+
+    def components(self, theta_i, theta_s, phi_s) -> np.ndarray:
+        """The components' Mueller matrices [sr⁻¹] at model angles:
+        broadcast(angles) + (T, 3, 4, 4); zero at or below the horizon."""
+        ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s)
+        wi = np.stack((-np.sin(ti), np.zeros_like(ti), np.cos(ti)), -1)  # towards the light (azimuth π)
+        wo = np.stack((np.sin(ts) * np.cos(ps), np.sin(ts) * np.sin(ps), np.cos(ts)), -1)
+        h = wi + wo
+        h /= np.linalg.norm(h, axis=-1, keepdims=True)
+        phi_h = np.arctan2(h[..., 1], h[..., 0])
+        theta_h = np.arccos(np.clip(h[..., 2], -1.0, 1.0))
+        d = basis.about_normal(wi, -phi_h)  # into the half frame, then R_y(-θh)
+        c, s = np.cos(theta_h), np.sin(theta_h)
+        d = np.stack((c * d[..., 0] - s * d[..., 2], d[..., 1], s * d[..., 0] + c * d[..., 2]), -1)
+        theta_d = np.arccos(np.clip(d[..., 2], -1.0, 1.0))
+        phi_d = np.arctan2(d[..., 1], d[..., 0])
+        n_p, n_d, n_u = self.data.shape[2:5]
+        coords = (
+            np.clip(np.abs(phi_d) / np.pi, 0.0, 1.0) * (n_p - 1),
+            np.clip(theta_d / HALF_PI, 0.0, 1.0) * (n_d - 1),
+            np.sqrt(np.clip(theta_h / HALF_PI, 0.0, 1.0)) * (n_u - 1),
+        )
+        g = table.trilinear(self._flat, coords).reshape(ti.shape + (self._tiles, len(COMPONENTS), 4, 4))
+        g = np.where((phi_d < 0)[..., None, None, None, None], MIRROR @ g @ MIRROR, g)
+        # From the half frame's transported bases to the models' frame's.
+        psi = []
+        for k in (-wi, wo):
+            s_half = basis.about_normal(basis.transported_basis(basis.about_normal(k, -phi_h))[0], phi_h)
+            psi.append(basis.turn(k, s_half, np.cross(k, s_half), basis.transported_basis(k)[0]))
+        flat = g.reshape(ti.shape + (-1, 4, 4))
+        g = basis.refer(flat, *psi).reshape(g.shape)
+        up = (ti < HALF_PI) & (ts < HALF_PI)
+        cos2 = np.where(up, np.cos(ti) * np.cos(ts), 1.0)
+        return np.where(up[..., None, None, None, None], g / cos2[..., None, None, None, None], 0.0)
+
+    def mueller(self, theta_i, theta_s, phi_s, paint: Paint) -> np.ndarray:
+        """A paint's (of this type) Mueller matrix per RGB channel,
+        broadcast(angles) + (3, 4, 4): Σ_c a_c·M_c."""
+        if json.loads(lutfile.canonical_json(paint.type_dict())) != self.meta["type"]:
+            raise ValueError(f"paint is not of this Mueller LUT's type {self.meta['type']}")
+        comps = self.components(theta_i, theta_s, phi_s)
+        amps = (
+            paint.amplitudes(self.meta.get("diffuse_nodes", DIFFUSE_NODES))
+            if paint.dispersive
+            else np.stack(paint._weights(self.internal_reflectance), axis=1)
+        )
+        comps = np.broadcast_to(comps, comps.shape[:-4] + (3,) + comps.shape[-3:])
+        return np.einsum("...hcij,hc->...hij", comps, amps)
+
+
+def load_mueller_lut(path) -> MuellerLUT:
+    """Load and verify a Mueller LUT file; raises lut.LUTError (a
+    ValueError) naming the file for a missing, damaged or foreign one."""
+    pixels, attrs = lutfile.read_exr_attributes(path, "Mueller LUT file", {"paintlut:mueller": MUELLER_FORMAT})
+    try:
+        meta = json.loads(attrs.get("paintlut:meta"))
+        n_u, n_d, n_p = (int(r) for r in meta["resolution"])
+        tiles = int(meta["tiles"])
+    except (TypeError, ValueError, KeyError):
+        raise lutfile.LUTError(f"{path}: its paintlut:meta is malformed (altered file)") from None
+    if attrs.get("paintlut:key") != lutfile.cache_key(meta):
+        raise lutfile.LUTError(f"{path}: header key does not match its meta (altered file)")
+    if pixels.shape != (tiles * 16 * n_p * n_d, n_u, len(COMPONENTS)):
+        raise lutfile.LUTError(f"{path}: image size {pixels.shape} does not match resolution {meta['resolution']}")
+    data = pixels.reshape(tiles, 16, n_p, n_d, n_u, len(COMPONENTS))
+    return MuellerLUT(data, meta, pathlib.Path(path), attrs["paintlut:key"])
+
+
+def accuracy(table: MuellerLUT, paint: Paint, steps=17, azimuths=24) -> dict:
+    """How near a Mueller LUT's matrices of a paint come to the models'
+    (``Paint.mueller`` in the transported bases), as the M00 LUT's accuracy
+    is measured (docs/lut.md): ``rms`` (4, 4), each element's cos θi-weighted
+    RMS error over θi, θs in [0°, 80°] (``steps`` each) and ``azimuths``
+    azimuths, relative to M00's RMS, over RGB; ``poles``: the largest error
+    of an element other than M00 relative to M00, and ``poles_m00`` of M00,
+    at light or view along the normal (and 1e-6 rad off it) with the other
+    ray to 80° all round."""
+    t = np.radians(np.linspace(0.0, 80.0, steps))
+    ti, ts, ps = (a.ravel() for a in np.meshgrid(t, t, np.linspace(-np.pi, np.pi, azimuths), indexing="ij"))
+    got = table.mueller(ti, ts, ps, paint)
+    ref = basis.mueller_in_transported_basis(paint.mueller(ti, ts, ps), ti, ts, ps)
+    w = np.cos(ti)[:, None, None, None]
+    rms = np.sqrt(np.sum(((got - ref) * w) ** 2, axis=(0, 1)) / np.sum((ref[..., :1, :1] * w) ** 2))
+    x, phi = (
+        a.ravel()
+        for a in np.meshgrid(np.radians(np.linspace(0.0, 80.0, 9)), np.linspace(-np.pi, np.pi, 13), indexing="ij")
+    )
+    poles, poles_m00 = 0.0, 0.0
+    for pole in (0.0, 1e-6):
+        for a, b in ((np.full_like(x, pole), x), (x, np.full_like(x, pole))):
+            g = table.mueller(a, b, phi, paint)
+            r = basis.mueller_in_transported_basis(paint.mueller(a, b, phi), a, b, phi)
+            rel = np.abs(g - r) / r[..., :1, :1]
+            poles_m00 = max(poles_m00, float(rel[..., 0, 0].max()))
+            rel[..., 0, 0] = 0.0
+            poles = max(poles, float(rel.max()))
+    polarizes = bool(np.abs(ref[..., 1:, :]).max() > 0.01 * np.abs(ref[..., 0, 0]).max())
+    return {"rms": rms, "poles": poles, "poles_m00": poles_m00, "polarizes": polarizes}
