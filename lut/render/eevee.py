@@ -23,8 +23,11 @@ taking the exact roughness and IOR; outside they are held at the ends."""
 from __future__ import annotations
 
 import base64
+import collections
 import functools
+import hashlib
 import io
+import threading
 
 import numpy as np
 
@@ -146,24 +149,51 @@ def tables(version=(5, 0)) -> dict:
     return decode(stored[key])
 
 
+#: The last stencils ``_corners`` computed, by the bytes of their
+#: geometry: a fit looks up every candidate closure at the same rows.
+_STENCILS: collections.OrderedDict = collections.OrderedDict()
+_STENCILS_LOCK = threading.Lock()
+
+
 def _corners(theta_l, theta_v, phi):
+    """``_stencil``, remembered for the last few geometries (each of a
+    fit's candidate closures is looked up at the same rows)."""
+    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (theta_l, theta_v, phi)))
+    digest = hashlib.blake2b(digest_size=16)
+    for a in arrays:
+        digest.update(a.tobytes())
+    key = (arrays[0].shape, digest.digest())
+    with _STENCILS_LOCK:
+        if key in _STENCILS:
+            _STENCILS.move_to_end(key)
+            return _STENCILS[key]
+    found = _stencil(*arrays)
+    for a in found:
+        a.setflags(write=False)  # shared between callers
+    with _STENCILS_LOCK:
+        _STENCILS[key] = found
+        while len(_STENCILS) > 4:
+            _STENCILS.popitem(last=False)
+    return found
+
+
+def _stencil(theta_l, theta_v, phi):
     """The trilinear stencil of (θl, θv, |φ|) on the tables' grid, held at
-    its edges: flat cell indices (..., 8) and weights (..., 8)."""
-    idx, frac = [], []
-    for a, grid in ((theta_l, THETA), (theta_v, THETA), (np.abs(phi), PHI)):
+    its edges: flat cell indices (..., 8) and weights (..., 8), corner c
+    taking the upper node along axis b where bit b of c is set."""
+    strides = np.array([TABLE_SHAPE[1] * TABLE_SHAPE[2], TABLE_SHAPE[2], 1])
+    bits = (np.arange(8)[:, None] >> np.arange(3)) & 1  # (8 corners, 3 axes)
+    base, lower, upper = 0, [], []
+    for axis, (a, grid) in enumerate(((theta_l, THETA), (theta_v, THETA), (np.abs(phi), PHI))):
         x = np.clip((a - grid[0]) / (grid[1] - grid[0]), 0.0, grid.size - 1.0)
         i = np.minimum(np.floor(x).astype(int), grid.size - 2)
-        idx.append(i)
-        frac.append(x - i)
-    cells, weights = [], []
-    for corner in range(8):
-        bits = [(corner >> b) & 1 for b in range(3)]
-        w = 1.0
-        for b, f in zip(bits, frac, strict=True):
-            w = w * (f if b else 1.0 - f)
-        cells.append(np.ravel_multi_index([i + b for i, b in zip(idx, bits, strict=True)], TABLE_SHAPE))
-        weights.append(np.broadcast_to(w, cells[-1].shape))
-    return np.stack(cells, -1), np.stack(weights, -1)
+        base = base + i * strides[axis]
+        upper.append(x - i)
+        lower.append(1.0 - upper[-1])
+    weights = np.ones(np.shape(base) + (8,))
+    for axis in range(3):
+        weights *= np.where(bits[:, axis], upper[axis][..., None], lower[axis][..., None])
+    return base[..., None] + bits @ strides, weights
 
 
 def _trilinear(table, theta_l, theta_v, phi):
@@ -246,7 +276,9 @@ def ratio(closure: Closure, theta_l, theta_v, phi, version=(5, 0)):
     if not keys or any(k not in data for k in keys):
         raise ValueError(f"the Blender {_version_key(version)} tables lack {kind!r}")
     total = sum(keys.values())
-    return sum((w / total) * _trilinear(data[k], theta_l, theta_v, phi) for k, w in keys.items())
+    # Trilinear interpolation is linear in the table: blend the tables, then look up once.
+    blended = sum((w / total) * np.asarray(data[k], dtype=float) for k, w in keys.items())
+    return _trilinear(blended, theta_l, theta_v, phi)
 
 
 def evaluate(closure: Closure, theta_l, theta_v, phi, version=(5, 0)):
