@@ -310,3 +310,13 @@ def test_processes_racing_to_bake_one_type_into_one_store_leave_one_valid_set(tm
     table = lut.load_lut(luts[0])  # verified against its hash
     assert all(fitting.read_fit(f).lut_key == table.key for f in fits)
     assert not [p for p in store.iterdir() if p.name.startswith(".")]
+
+
+def test_a_rough_dispersive_paint_evaluates_from_its_lut(tmp_path):
+    """A dispersive paint's amplitudes are recomputed from the LUT's own
+    quadrature (read back from JSON as a list): the rough case evaluates,
+    near the model."""
+    paint = lut.Paint(n=(1.49, 0.006), rho="ColorChecker N Ohta/red", single=0.1, slope=0.3)
+    table_ = lut.load_lut(lut.bake(paint, tmp_path))
+    ti, ts, ps = np.radians([10.0, 40.0, 60.0]), np.radians([30.0, 50.0, 20.0]), np.array([0.5, 2.0, 3.0])
+    np.testing.assert_allclose(table_.evaluate(ti, ts, ps, paint), paint.brdf(ti, ts, ps), rtol=0.02)

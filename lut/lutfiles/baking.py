@@ -155,7 +155,7 @@ class LUT:
         if not self.matches(paint):
             raise ValueError(f"paint is not of this LUT's type {self.meta['type']}")
         if paint.dispersive:
-            return paint.amplitudes(self.meta.get("diffuse_nodes", DIFFUSE_NODES))
+            return paint.amplitudes(tuple(self.meta.get("diffuse_nodes", DIFFUSE_NODES)))  # JSON gives a list
         return np.stack(paint._weights(self.internal_reflectance), axis=1)
 
     def evaluate(self, theta_i, theta_s, phi_s, paint: Paint) -> np.ndarray:
