@@ -68,6 +68,61 @@ def test_mirror_images_have_u_and_v_reversed(baked):
     )
 
 
+@pytest.mark.parametrize(
+    "paint",
+    [
+        lut.Paint(n=1.6, rho=(0.5, 0.2, 0.1), single=(0.1, 0.2, 0.05), g=-0.3, slope=0.4, distribution="gaussian"),
+        lut.Paint(n=(1.49, 0.006), rho="ColorChecker N Ohta/red", single=0.1, g=0.2, slope=0.2),  # dispersive
+    ],
+    ids=["gaussian", "dispersive"],
+)
+def test_at_its_own_nodes_a_coarse_table_returns_the_models_matrices(tmp_path, paint):
+    """Looked up at the geometries of its nodes above the horizon, a coarse
+    table returns the models' matrices (the bake's quadrature) to float32
+    rounding: the half frame, its turn and the fold are undone exactly,
+    for each RGB channel of a dispersive paint too."""
+    resolution = (9, 7, 9)
+    table = mueller_lut.load_mueller_lut(mueller_lut.bake_mueller(paint, tmp_path, resolution=resolution))
+    ti, ts, ps, _ = (a.ravel() for a in mueller_lut.node_geometry(resolution))
+    keep = (ti < np.radians(88.0)) & (ts < np.radians(88.0))
+    ti, ts, ps = ti[keep], ts[keep], ps[keep]
+    assert ti.size > 200
+    got = table.mueller(ti, ts, ps, paint)
+    nodes = {"single_nodes": tuple(table.meta["single_nodes"]), "diffuse_nodes": tuple(table.meta["diffuse_nodes"])}
+    ref = _reference_nodes(paint, ti, ts, ps, nodes)
+    np.testing.assert_allclose(got, ref, atol=2e-6 * np.abs(ref[..., 0, 0]).max(), rtol=1e-5)
+
+
+def _reference_nodes(paint, ti, ts, ps, nodes):
+    return basis.mueller_in_transported_basis(paint.mueller(ti, ts, ps, **nodes), ti, ts, ps)
+
+
+def test_a_shading_frame_turned_about_the_normal_gets_its_own_bases(baked):
+    """``frame``: the matrix referred to the transported bases of a frame
+    turned about the normal (a renderer's, where the light lies at any
+    azimuth) matches the models referred to the same bases, and differs
+    from the models' frame by tens of per cent of M00 near the normal."""
+    table, paint = baked[1][1], RANDOM[1][1]
+    rng = np.random.default_rng(4)
+    ti, ts, ps = rng.uniform(0, 1.2, 60), rng.uniform(0, 1.2, 60), rng.uniform(-np.pi, np.pi, 60)
+    frame = rng.uniform(-np.pi, np.pi, 60)
+    got = table.mueller(ti, ts, ps, paint, frame=frame)
+    ref = basis.mueller_in_transported_basis(paint.mueller(ti, ts, ps), ti, ts, ps, frame)
+    scale = ref[..., :1, :1]
+    assert np.sqrt(np.mean(((got - ref) / scale) ** 2)) < 0.01
+    assert np.max(np.abs(got - table.mueller(ti, ts, ps, paint)) / scale) > 0.1
+
+
+def test_below_the_horizon_nothing_is_scattered_even_opposite_the_view(baked):
+    """Light below the horizon (its half vector with the view may vanish,
+    light and view exactly opposite) or view below it: zero, no error."""
+    table, paint = baked[1][1], RANDOM[1][1]
+    x = np.array([0.1, 0.5, 1.0])
+    got = table.mueller(np.pi / 2 + x, np.pi / 2 - x, 0.0, paint)
+    assert got.shape == (3, 3, 4, 4) and np.all(got == 0.0)
+    assert np.all(table.mueller(0.3, np.pi / 2, 1.0, paint) == 0.0)
+
+
 def test_every_colour_of_a_type_shares_one_file_and_a_second_bake_computes_nothing(baked):
     directory, tables = baked
     paint = RANDOM[21][1]

@@ -50,7 +50,7 @@ def test_a_paints_mueller_matrix_is_its_models_weighted_and_its_m00_is_its_brdf(
         )
     expected = sum(t[:, None] * amps[None, :, c, None, None] for c, t in enumerate(terms))
     np.testing.assert_allclose(mueller, expected, rtol=1e-12, atol=1e-13 * brdf.max())
-    # Not depolarizing alone: light polarized 45° comes back partly polarized.
+    # Not depolarizing alone: unpolarized light comes back partly polarized.
     assert np.abs(mueller[..., 1:, 0]).max() > 1e-3 * brdf.max()
 
 
@@ -73,6 +73,14 @@ def test_the_transported_basis_is_orthonormal_and_smooth_through_the_poles():
     np.testing.assert_allclose(geometry.dot(s, k), 0.0, atol=1e-12)
     np.testing.assert_allclose(geometry.dot(s, s), 1.0, atol=1e-12)
     np.testing.assert_allclose(p, geometry.cross(k, s), atol=1e-15)
+    # s is x̂ carried from the nearest pole: turned about (pole × k) by the angle between them (Rodrigues).
+    pole = np.where(k[:, 2:] >= 0, 1.0, -1.0) * np.array([0.0, 0.0, 1.0])
+    axis = geometry.cross(pole, k)
+    axis /= np.linalg.norm(axis, axis=-1, keepdims=True)
+    angle = np.arccos(np.clip(geometry.dot(pole, k), -1.0, 1.0))[:, None]
+    x = np.array([1.0, 0.0, 0.0])
+    carried = x * np.cos(angle) + np.cross(axis, x) * np.sin(angle) + axis * (axis @ x)[:, None] * (1 - np.cos(angle))
+    np.testing.assert_allclose(s, carried, atol=1e-12)
     # At either pole s is x̂, and a ray 1e-6 rad from it, at any azimuth, has
     # its s within 2e-6 of x̂: no azimuth-dependent limit.
     for z in (1.0, -1.0):

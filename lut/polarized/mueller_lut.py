@@ -36,6 +36,7 @@ parameterization), ``paintlut:key`` and ``paintlut:hash``.
 
 from __future__ import annotations
 
+import concurrent.futures
 import json
 import pathlib
 
@@ -136,7 +137,10 @@ def bake_mueller(
     return _bake(paint, path, meta, chunk)
 
 
-def _bake(paint, path, meta, chunk=2048):
+def _bake(paint, path, meta, chunk=2048, workers=None):
+    """Tabulate G of every node in chunks on ``workers`` threads (default
+    ``table.default_workers``: numpy releases the interpreter lock inside
+    the models' array operations) and write the file."""
     ti, ts, ps, frame = (a.ravel() for a in node_geometry(tuple(meta["resolution"])))
     opts = {
         "single_nodes": tuple(meta.get("single_nodes", baking.BAKE_SINGLE_NODES)),
@@ -144,13 +148,18 @@ def _bake(paint, path, meta, chunk=2048):
     }
     tiles = meta["tiles"]
     out = np.empty((ti.size, tiles, len(COMPONENTS), 4, 4))
-    for start in range(0, ti.size, chunk):
+
+    def run(start):
         sl = slice(start, start + chunk)
         m = paint.components(ti[sl], ts[sl], ps[sl], mueller=True, **opts)  # (n, T, 3, 4, 4), SCATMECH bases
         m = basis.mueller_in_transported_basis(m.reshape(m.shape[0], -1, 4, 4), ti[sl], ts[sl], ps[sl], frame[sl])
-        out[sl] = (
-            m.reshape(-1, tiles, len(COMPONENTS), 4, 4) * (np.cos(ti[sl]) * np.cos(ts[sl]))[:, None, None, None, None]
-        )
+        cos2 = np.cos(ti[sl]) * np.cos(ts[sl])
+        out[sl] = m.reshape(-1, tiles, len(COMPONENTS), 4, 4) * cos2[:, None, None, None, None]
+
+    workers = table.default_workers() if workers is None else max(1, int(workers))
+    with concurrent.futures.ThreadPoolExecutor(max_workers=workers, thread_name_prefix="paint-mueller") as pool:
+        for future in [pool.submit(run, start) for start in range(0, ti.size, chunk)]:
+            future.result()
     n_u, n_d, n_p = meta["resolution"]
     grid = out.reshape(n_p, n_d, n_u, tiles, len(COMPONENTS), 16)
     image = np.ascontiguousarray(np.transpose(grid, (3, 5, 0, 1, 2, 4)).reshape(-1, n_u, len(COMPONENTS)), np.float32)
@@ -190,10 +199,19 @@ class MuellerLUT:
     def internal_reflectance(self) -> float:
         return float(self.meta["internal_reflectance"])
 
-    def components(self, theta_i, theta_s, phi_s) -> np.ndarray:
+    def components(self, theta_i, theta_s, phi_s, frame=0.0) -> np.ndarray:
         """The components' Mueller matrices [sr⁻¹] at model angles:
-        broadcast(angles) + (T, 3, 4, 4); zero at or below the horizon."""
-        ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s)
+        broadcast(angles) + (T, 3, 4, 4); zero at or below the horizon.
+        Referred to the transported bases of the models' frame, or of a
+        frame turned from it by ``frame`` (radians, broadcast with the
+        angles) about the normal, as ``basis.mueller_in_transported_basis``
+        refers them: a renderer's shading frame, in which the source lies at
+        azimuth π + frame."""
+        ti, ts, ps, frame = np.broadcast_arrays(*_validate.angles(theta_i, theta_s, phi_s), np.asarray(frame, float))
+        up = (ti < HALF_PI) & (ts < HALF_PI)
+        # Geometries at or below the horizon render nothing; looked up at the normal instead
+        # (their half vector may vanish: light and view opposite).
+        ti, ts = np.where(up, ti, 0.0), np.where(up, ts, 0.0)
         wi = np.stack((-np.sin(ti), np.zeros_like(ti), np.cos(ti)), -1)  # towards the light (azimuth π)
         wo = np.stack((np.sin(ts) * np.cos(ps), np.sin(ts) * np.sin(ps), np.cos(ts)), -1)
         h = wi + wo
@@ -213,25 +231,26 @@ class MuellerLUT:
         )
         g = table.trilinear(self._flat, coords).reshape(ti.shape + (self._tiles, len(COMPONENTS), 4, 4))
         g = np.where((phi_d < 0)[..., None, None, None, None], MIRROR @ g @ MIRROR, g)
-        # From the half frame's transported bases to the models' frame's.
+        # From the half frame's transported bases to the wanted frame's, per ray.
         psi = []
         for k in (-wi, wo):
             s_half = basis.about_normal(basis.transported_basis(basis.about_normal(k, -phi_h))[0], phi_h)
-            psi.append(basis.turn(k, s_half, np.cross(k, s_half), basis.transported_basis(k)[0]))
+            s_to = basis.about_normal(basis.transported_basis(basis.about_normal(k, frame))[0], -frame)
+            psi.append(basis.turn(k, s_half, np.cross(k, s_half), s_to))
         flat = g.reshape(ti.shape + (-1, 4, 4))
         g = basis.refer(flat, *psi).reshape(g.shape)
-        up = (ti < HALF_PI) & (ts < HALF_PI)
         cos2 = np.where(up, np.cos(ti) * np.cos(ts), 1.0)
         return np.where(up[..., None, None, None, None], g / cos2[..., None, None, None, None], 0.0)
 
-    def mueller(self, theta_i, theta_s, phi_s, paint: Paint) -> np.ndarray:
+    def mueller(self, theta_i, theta_s, phi_s, paint: Paint, frame=0.0) -> np.ndarray:
         """A paint's (of this type) Mueller matrix per RGB channel,
-        broadcast(angles) + (3, 4, 4): Σ_c a_c·M_c."""
+        broadcast(angles) + (3, 4, 4): Σ_c a_c·M_c (``frame`` as in
+        ``components``)."""
         if json.loads(lutfile.canonical_json(paint.type_dict())) != self.meta["type"]:
             raise ValueError(f"paint is not of this Mueller LUT's type {self.meta['type']}")
-        comps = self.components(theta_i, theta_s, phi_s)
+        comps = self.components(theta_i, theta_s, phi_s, frame)
         amps = (
-            paint.amplitudes(self.meta.get("diffuse_nodes", DIFFUSE_NODES))
+            paint.amplitudes(tuple(self.meta.get("diffuse_nodes", DIFFUSE_NODES)))
             if paint.dispersive
             else np.stack(paint._weights(self.internal_reflectance), axis=1)
         )
