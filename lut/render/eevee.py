@@ -153,6 +153,9 @@ def tables(version=(5, 0)) -> dict:
 #: geometry: a fit looks up every candidate closure at the same rows.
 _STENCILS: collections.OrderedDict = collections.OrderedDict()
 _STENCILS_LOCK = threading.Lock()
+#: Geometries of more points than this are not remembered (a stencil holds
+#: 128 bytes per point).
+_STENCIL_POINTS = 200_000
 
 
 def _corners(theta_l, theta_v, phi):
@@ -168,6 +171,8 @@ def _corners(theta_l, theta_v, phi):
             _STENCILS.move_to_end(key)
             return _STENCILS[key]
     found = _stencil(*arrays)
+    if arrays[0].size > _STENCIL_POINTS:  # a calibration's pixels: used once, not worth keeping
+        return found
     for a in found:
         a.setflags(write=False)  # shared between callers
     with _STENCILS_LOCK:
