@@ -69,8 +69,9 @@ def test_converged_fits_of_sharp_exponential_paints_come_near_the_model(random_s
     that keeps its exact fit would gain in bias (a converged fit of it is
     within 14% too) but not at the viewport's samples: its sharp lobe peaks at
     the grazing mirror, where EEVEE seldom picks it, so its pixels there
-    scatter so widely that bias and spread together exceed what the
-    converged mode must gain (``CONVERGED_GAIN``)."""
+    scatter so widely that, at its colour, bias and spread together are
+    more than ``CONVERGED_GAIN`` times the exact fit's error (the fit's own
+    rule weighs the same two over the type's component colours)."""
     kept = 0
     for paint, table, exact, converged in random_set:
         if paint.distribution != "exponential" or not 0.05 < paint.slope < 0.25:

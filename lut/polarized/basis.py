@@ -16,7 +16,9 @@ z = 0):
 
     s = (1 - σ x²/(σ + z), -σ x y/(σ + z), -σ x),
 
-T. Duff et al., "Building an Orthonormal Basis, Revisited", JCGT 6(1), 2017,
+T. Duff, J. Burgess, P. Christensen, C. Hery, A. Kensler, M. Liani and
+R. Villemin, "Building an Orthonormal Basis, Revisited", Journal of
+Computer Graphics Techniques 6(1), 2017,
 Listing 3 (the first vector); Mitsuba 3 takes the same vector as its Stokes
 basis of a direction (``mueller::stokes_basis``).  It is smooth on each
 open hemisphere, poles included.
@@ -26,7 +28,8 @@ s' = cos ψ s + sin ψ p (p' = k×s'), the Jones components turn by
 R(ψ) = [[cos ψ, sin ψ], [-sin ψ, cos ψ]] and the Stokes vector by
 L(ψ) = M(R(ψ)) (``stokes_rotation``), so a Mueller matrix M referred to the
 s/p bases is, in the transported ones, L(ψ_s) · M · L(ψ_i)⁻¹ (the rule of
-R. A. Chipman et al., "Polarized Light and Optical Systems", CRC 2018,
+R. A. Chipman, W. S. T. Lam and G. Young, "Polarized Light and Optical
+Systems", CRC Press, 2018,
 Sec. 6.4).  M00 is unchanged."""
 
 from __future__ import annotations
