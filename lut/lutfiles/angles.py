@@ -20,6 +20,16 @@ def to_half_diff(theta_i, theta_s, phi_s):
     """(θh, θd, φd) of the light direction ω_i = (-sin θi, 0, cos θi) and the
     view direction ω_o = (sin θs cos φs, sin θs sin φs, cos θs), with φd
     folded into [0, π/2]."""
+    theta_h, theta_d, phi_d, _ = half_diff_signed(theta_i, theta_s, phi_s)
+    phi_d = np.abs(phi_d)  # mirror symmetry: φd -> -φd
+    phi_d = np.where(phi_d > np.pi / 2, np.pi - phi_d, phi_d)  # reciprocity and mirror: φd -> π - φd
+    return theta_h, theta_d, phi_d
+
+
+def half_diff_signed(theta_i, theta_s, phi_s):
+    """(θh, θd, φd, φh) of model angles with φd in (-π, π], unfolded, and
+    φh the half vector's azimuth in the models' frame (where the source
+    lies at azimuth π): ω_i = R_z(φh) R_y(θh) d."""
     theta_i, theta_s, phi_s = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (theta_i, theta_s, phi_s)))
     wi = np.stack((-np.sin(theta_i), np.zeros_like(theta_i), np.cos(theta_i)), -1)
     st = np.sin(theta_s)
@@ -37,24 +47,27 @@ def to_half_diff(theta_i, theta_s, phi_s):
     c, s = np.cos(-theta_h), np.sin(-theta_h)
     dx, dz = c * x + s * z, -s * x + c * z
     theta_d = np.arccos(np.clip(dz, -1.0, 1.0))
-    phi_d = np.abs(np.arctan2(y, dx))  # mirror symmetry: φd -> -φd
-    phi_d = np.where(phi_d > np.pi / 2, np.pi - phi_d, phi_d)  # reciprocity and mirror: φd -> π - φd
-    return theta_h, theta_d, phi_d
+    return theta_h, theta_d, np.arctan2(y, dx), phi_h
 
 
-def from_half_diff(theta_h, theta_d, phi_d):
-    """(θi, θs, φs) of half/difference angles (any φh: the BRDF is isotropic,
-    so φh = 0 is used).  θi or θs >= π/2 lie below the horizon."""
+def half_frame_rays(theta_h, theta_d, phi_d):
+    """Unit vectors towards the light and the viewer in the half frame (the
+    half vector at azimuth 0): ω_i = R_y(θh) d and ω_o = R_y(θh) d', d' the
+    mirror of d about the half vector, each broadcast(angles) + (3,)."""
     theta_h, theta_d, phi_d = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (theta_h, theta_d, phi_d)))
     d = np.stack((np.sin(theta_d) * np.cos(phi_d), np.sin(theta_d) * np.sin(phi_d), np.cos(theta_d)), -1)
-    # ω_i = R_y(θh) d, ω_o = R_y(θh) d' with d' = (-dx, -dy, dz) (the mirror of d about the half vector)
     c, s = np.cos(theta_h), np.sin(theta_h)
 
     def rot(v):
         return np.stack((c * v[..., 0] + s * v[..., 2], v[..., 1], -s * v[..., 0] + c * v[..., 2]), -1)
 
-    wi = rot(d)
-    wo = rot(d * np.array([-1.0, -1.0, 1.0]))
+    return rot(d), rot(d * np.array([-1.0, -1.0, 1.0]))
+
+
+def from_half_diff(theta_h, theta_d, phi_d):
+    """(θi, θs, φs) of half/difference angles (any φh: the BRDF is isotropic,
+    so φh = 0 is used).  θi or θs >= π/2 lie below the horizon."""
+    wi, wo = half_frame_rays(theta_h, theta_d, phi_d)
     theta_i = np.arccos(np.clip(wi[..., 2], -1.0, 1.0))
     theta_s = np.arccos(np.clip(wo[..., 2], -1.0, 1.0))
     phi_light = np.arctan2(wi[..., 1], wi[..., 0])

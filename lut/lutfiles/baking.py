@@ -122,6 +122,22 @@ def bake(
     return lutfile.write(path, np.moveaxis(data.reshape(n_p, n_d, n_u, tiles, 3), 3, 0), meta)
 
 
+def matches(meta: dict, paint: Paint) -> bool:
+    """Whether ``paint`` is of the type a bake's ``meta`` describes."""
+    return json.loads(lutfile.canonical_json(paint.type_dict())) == meta["type"]
+
+
+def amplitudes(meta: dict, paint: Paint, what="LUT") -> np.ndarray:
+    """(3 channels, 3 components) amplitudes of a paint of the type a bake's
+    ``meta`` describes, with the bake's r̄ (a dispersive paint's from the
+    bake's quadrature); ValueError, naming ``what``, for another type."""
+    if not matches(meta, paint):
+        raise ValueError(f"paint is not of this {what}'s type {meta['type']}")
+    if paint.dispersive:
+        return paint.amplitudes(tuple(meta.get("diffuse_nodes", DIFFUSE_NODES)))  # JSON gives a list
+    return np.stack(paint._weights(float(meta["internal_reflectance"])), axis=1)
+
+
 class LUT:
     """A loaded LUT of a paint type: ``components(θi, θs, φs)`` gives the
     interpolated angular components, ``evaluate(θi, θs, φs, paint)`` the RGB
@@ -141,7 +157,7 @@ class LUT:
 
     def matches(self, paint: Paint) -> bool:
         """Whether ``paint`` is of this LUT's type."""
-        return json.loads(lutfile.canonical_json(paint.type_dict())) == self.meta["type"]
+        return matches(self.meta, paint)
 
     def components(self, theta_i, theta_s, phi_s) -> np.ndarray:
         """Components at model angles: broadcast(angles) + (tiles, 3)."""
@@ -152,11 +168,7 @@ class LUT:
 
     def amplitudes(self, paint: Paint) -> np.ndarray:
         """(3 channels, 3 components) amplitudes of a paint of this type."""
-        if not self.matches(paint):
-            raise ValueError(f"paint is not of this LUT's type {self.meta['type']}")
-        if paint.dispersive:
-            return paint.amplitudes(tuple(self.meta.get("diffuse_nodes", DIFFUSE_NODES)))  # JSON gives a list
-        return np.stack(paint._weights(self.internal_reflectance), axis=1)
+        return amplitudes(self.meta, paint)
 
     def evaluate(self, theta_i, theta_s, phi_s, paint: Paint) -> np.ndarray:
         """The RGB BRDF of ``paint`` (of this LUT's type): Σ_c a_c·B_c."""

@@ -42,7 +42,7 @@ import pathlib
 
 import numpy as np
 
-from ..lutfiles import baking, table
+from ..lutfiles import angles, baking, table
 from ..lutfiles import format as lutfile
 from ..models import _validate
 from ..models.rough import DIFFUSE_NODES
@@ -83,25 +83,12 @@ def _axes(resolution):
     return HALF_PI * u * u, np.linspace(0.0, HALF_PI, n_d), np.linspace(0.0, np.pi, n_p)
 
 
-def _half_frame_rays(theta_h, theta_d, phi_d):
-    """Unit vectors towards the light and the viewer in the half frame
-    (Rusinkiewicz: ω = R_y(θh)·d, d and its mirror about the half vector)."""
-    theta_h, theta_d, phi_d = np.broadcast_arrays(theta_h, theta_d, phi_d)
-    d = np.stack((np.sin(theta_d) * np.cos(phi_d), np.sin(theta_d) * np.sin(phi_d), np.cos(theta_d)), -1)
-    c, s = np.cos(theta_h), np.sin(theta_h)
-
-    def rot(v):
-        return np.stack((c * v[..., 0] + s * v[..., 2], v[..., 1], -s * v[..., 0] + c * v[..., 2]), -1)
-
-    return rot(d), rot(d * np.array([-1.0, -1.0, 1.0]))
-
-
 def node_geometry(resolution):
     """Per node (N_φd, N_θd, N_u): model angles (θi, θs, φs), polar angles
     clamped to ``table.HORIZON_CLAMP``, and the half frame's turn from the
     models' frame (the light's azimuth there minus π)."""
     th, td, pd = _axes(resolution)
-    wi, wo = _half_frame_rays(th[None, None, :], td[None, :, None], pd[:, None, None])
+    wi, wo = angles.half_frame_rays(th[None, None, :], td[None, :, None], pd[:, None, None])
     light = np.arctan2(wi[..., 1], wi[..., 0])
     view = np.arctan2(wo[..., 1], wo[..., 0])
     ti = np.minimum(np.arccos(np.clip(wi[..., 2], -1.0, 1.0)), table.HORIZON_CLAMP)
@@ -209,20 +196,10 @@ class MuellerLUT:
         azimuth π + frame."""
         ti, ts, ps, frame = np.broadcast_arrays(*_validate.angles(theta_i, theta_s, phi_s), np.asarray(frame, float))
         up = (ti < HALF_PI) & (ts < HALF_PI)
-        # Geometries at or below the horizon render nothing; looked up at the normal instead
-        # (their half vector may vanish: light and view opposite).
-        ti, ts = np.where(up, ti, 0.0), np.where(up, ts, 0.0)
+        ti, ts = np.where(up, ti, 0.0), np.where(up, ts, 0.0)  # at or below the horizon: zero, whatever is looked up
+        theta_h, theta_d, phi_d, phi_h = angles.half_diff_signed(ti, ts, ps)
         wi = np.stack((-np.sin(ti), np.zeros_like(ti), np.cos(ti)), -1)  # towards the light (azimuth π)
         wo = np.stack((np.sin(ts) * np.cos(ps), np.sin(ts) * np.sin(ps), np.cos(ts)), -1)
-        h = wi + wo
-        h /= np.linalg.norm(h, axis=-1, keepdims=True)
-        phi_h = np.arctan2(h[..., 1], h[..., 0])
-        theta_h = np.arccos(np.clip(h[..., 2], -1.0, 1.0))
-        d = basis.about_normal(wi, -phi_h)  # into the half frame, then R_y(-θh)
-        c, s = np.cos(theta_h), np.sin(theta_h)
-        d = np.stack((c * d[..., 0] - s * d[..., 2], d[..., 1], s * d[..., 0] + c * d[..., 2]), -1)
-        theta_d = np.arccos(np.clip(d[..., 2], -1.0, 1.0))
-        phi_d = np.arctan2(d[..., 1], d[..., 0])
         n_p, n_d, n_u = self.data.shape[2:5]
         coords = (
             np.clip(np.abs(phi_d) / np.pi, 0.0, 1.0) * (n_p - 1),
@@ -246,14 +223,8 @@ class MuellerLUT:
         """A paint's (of this type) Mueller matrix per RGB channel,
         broadcast(angles) + (3, 4, 4): Σ_c a_c·M_c (``frame`` as in
         ``components``)."""
-        if json.loads(lutfile.canonical_json(paint.type_dict())) != self.meta["type"]:
-            raise ValueError(f"paint is not of this Mueller LUT's type {self.meta['type']}")
+        amps = baking.amplitudes(self.meta, paint, "Mueller LUT")
         comps = self.components(theta_i, theta_s, phi_s, frame)
-        amps = (
-            paint.amplitudes(tuple(self.meta.get("diffuse_nodes", DIFFUSE_NODES)))
-            if paint.dispersive
-            else np.stack(paint._weights(self.internal_reflectance), axis=1)
-        )
         comps = np.broadcast_to(comps, comps.shape[:-4] + (3,) + comps.shape[-3:])
         return np.einsum("...hcij,hc->...hij", comps, amps)
 
