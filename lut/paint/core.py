@@ -147,6 +147,14 @@ _CHECKS = {
 _CHOICES = {"distribution": _validate.distribution, "space": cm.working_space}
 
 
+def _per_channel(term, weight, element):
+    """A term's value (shape angles + ``element``) times its RGB weight (3,):
+    angles + (3,) + element."""
+    return np.expand_dims(term, -1 - len(element)) * np.reshape(
+        np.asarray(weight, dtype=float), (3,) + (1,) * len(element)
+    )
+
+
 @dataclasses.dataclass(frozen=True)
 class Paint:
     """A paint (paper Sec. 4).  All fields are keywords; see the module
@@ -232,26 +240,24 @@ class Paint:
         ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s, broadcast=False)
         shape = np.broadcast_shapes(ti.shape, ts.shape, ps.shape)
         element = (4, 4) if mueller else ()
+        tail = (slice(None),) * len(element)
         if not self.dispersive:
             geo = self._geometry(ti, ts, ps, self.n, single_nodes, diffuse_nodes, every_term=True, mueller=mueller)
             out = np.zeros(shape + (1, 3) + element)
             for c, key in enumerate(COMPONENTS):
                 if key in geo:
-                    out[..., 0, c, *([slice(None)] * len(element))] = geo[key]
+                    out[(..., 0, c, *tail)] = geo[key]
             return out
         out = np.zeros(shape + (3, 3) + element)
         total = np.zeros((3, 3))
-        pad = (None,) * len(element)
         for n, band in self._bands():
             geo = self._geometry(ti, ts, ps, n, single_nodes, diffuse_nodes, every_term=True, mueller=mueller)
             weights = self._weights(geo["rbar"], band)
             for c, key in enumerate(COMPONENTS):
                 if key in geo:
-                    out[..., :, c, *([slice(None)] * len(element))] += (
-                        geo[key][..., None, *([slice(None)] * len(element))] * weights[c][(slice(None), *pad)]
-                    )
+                    out[(..., slice(None), c, *tail)] += _per_channel(geo[key], weights[c], element)
                     total[:, c] += weights[c]
-        return out / np.where(total > 0, total, 1.0)[(..., *pad)]
+        return out / np.where(total > 0, total, 1.0).reshape((3, 3) + (1,) * len(element))
 
     def amplitudes(self, diffuse_nodes=DIFFUSE_NODES) -> np.ndarray:
         """The weights of the components per RGB channel, (3 channels, 3
@@ -397,29 +403,27 @@ class Paint:
         """Polarization-averaged RGB BRDF [sr⁻¹] of all non-delta terms, shape
         broadcast(angles) + (3,), in the paint's working space.  Angles as in
         ``lut.models`` (radians; source at azimuth π)."""
-        ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s, broadcast=False)
-        out = np.zeros(np.broadcast_shapes(ti.shape, ts.shape, ps.shape) + (3,))
-        for n, band in self._bands():
-            geo = self._geometry(ti, ts, ps, n, single_nodes, diffuse_nodes)
-            w_facet, w_single, w_diffuse = self._weights(geo.get("rbar", 0.0), band)
-            for key, weight in (("facet", w_facet), ("single", w_single), ("diffuse", w_diffuse)):
-                if key in geo:
-                    out += geo[key][..., None] * weight
-        return out
+        return self._weighted_terms(theta_i, theta_s, phi_s, single_nodes, diffuse_nodes, mueller=False)
 
     def mueller(self, theta_i, theta_s, phi_s, *, single_nodes=SINGLE_NODES, diffuse_nodes=DIFFUSE_NODES):
         """Mueller BRDF [sr⁻¹] of all non-delta terms per RGB channel, shape
         broadcast(angles) + (3, 4, 4), in SCATMECH's s/p bases (``lut.models``,
         docs/models.md): the models' Mueller matrices weighted as in ``brdf``,
         whose values are its [..., 0, 0] elements."""
+        return self._weighted_terms(theta_i, theta_s, phi_s, single_nodes, diffuse_nodes, mueller=True)
+
+    def _weighted_terms(self, theta_i, theta_s, phi_s, single_nodes, diffuse_nodes, mueller):
+        """Σ over bands and terms of the term's RGB weight times its M00
+        (shape angles + (3,)) or its Mueller matrix (angles + (3, 4, 4)); only
+        terms of non-zero weight are computed."""
         ti, ts, ps = _validate.angles(theta_i, theta_s, phi_s, broadcast=False)
-        out = np.zeros(np.broadcast_shapes(ti.shape, ts.shape, ps.shape) + (3, 4, 4))
+        element = (4, 4) if mueller else ()
+        out = np.zeros(np.broadcast_shapes(ti.shape, ts.shape, ps.shape) + (3,) + element)
         for n, band in self._bands():
-            geo = self._geometry(ti, ts, ps, n, single_nodes, diffuse_nodes, mueller=True)
-            w_facet, w_single, w_diffuse = self._weights(geo.get("rbar", 0.0), band)
-            for key, weight in (("facet", w_facet), ("single", w_single), ("diffuse", w_diffuse)):
+            geo = self._geometry(ti, ts, ps, n, single_nodes, diffuse_nodes, mueller=mueller)
+            for key, weight in zip(COMPONENTS, self._weights(geo.get("rbar", 0.0), band), strict=True):
                 if key in geo:
-                    out += geo[key][..., None, :, :] * np.asarray(weight, dtype=float)[:, None, None]
+                    out += _per_channel(geo[key], weight, element)
         return out
 
     def specular_reflectance(self, theta_i):
