@@ -42,3 +42,21 @@ if [ -n "$python313" ]; then
         echo "$want" > "$stamp"
     fi
 fi
+
+# The Mitsuba 3 environment (.venv-mitsuba, requirements-mitsuba.txt) for the
+# polarized plugin germer_paint.  Where its packages cannot be installed (no
+# wheels for this platform, no network), say so and go on: its tests are
+# then skipped, and scripts/test.sh says that too.
+if [ ! -x .venv-mitsuba/bin/python ]; then
+    "$python" -m venv .venv-mitsuba
+fi
+stamp=.venv-mitsuba/.requirements.sha256
+want="$(sha256sum requirements-mitsuba.txt | cut -d' ' -f1)"
+if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
+    if .venv-mitsuba/bin/python -m pip install --quiet --upgrade pip \
+        && .venv-mitsuba/bin/python -m pip install --quiet -r requirements-mitsuba.txt; then
+        echo "$want" > "$stamp"
+    else
+        echo "bootstrap.sh: Mitsuba 3 could not be installed into .venv-mitsuba; its tests will be skipped" >&2
+    fi
+fi

@@ -14,7 +14,10 @@ def _readme_commands():
 def test_readme_has_an_example_command_and_a_test_command():
     commands = _readme_commands()
     assert any("-m lut example" in c for c in commands)
-    assert any("-m pytest" in c for c in commands)
+    assert any(c.endswith("bash scripts/test.sh") for c in commands)
+    test_sh = (ROOT / "scripts" / "test.sh").read_text()
+    assert ".venv/bin/python -m pytest" in test_sh  # every test, under Blender 5.0's environment
+    assert ".venv-mitsuba/bin/python -m pytest" in test_sh  # the Mitsuba plugin's, in its own
 
 
 def test_ci_runs_the_readme_commands():

@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# The README's test command runs this after scripts/bootstrap.sh: the test
+# suite in each environment bootstrap.sh made — every test under .venv (Blender 5.0's
+# pip bpy); the Blender test files again under .venv-bpy52 (Blender 5.2 LTS)
+# when a Python 3.13 made it; the Mitsuba 3 plugin's under .venv-mitsuba when
+# Mitsuba installed there.  Arguments go to every pytest run (for example
+# -m "not render").
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+cd "$root"
+
+.venv/bin/python -m pytest "$@"
+
+if [ -x .venv-bpy52/bin/python ]; then
+    mapfile -t blender_tests < <(grep -l 'importorskip("bpy")' tests/test_*.py)
+    .venv-bpy52/bin/python -m pytest "${blender_tests[@]}" "$@"
+else
+    echo "test.sh: no Python 3.13 here, so the Blender tests ran under Blender 5.0 only" >&2
+fi
+
+if [ -f .venv-mitsuba/.requirements.sha256 ]; then
+    mapfile -t mitsuba_tests < <(grep -l 'importorskip("mitsuba")' tests/test_*.py)
+    .venv-mitsuba/bin/python -m pytest "${mitsuba_tests[@]}" "$@"
+else
+    echo "test.sh: Mitsuba 3 is not installed (.venv-mitsuba), so the polarized plugin's tests were skipped" >&2
+fi
