@@ -138,3 +138,17 @@ def test_former_render_names_warn_and_work():
     with pytest.warns(DeprecationWarning, match="lut.render.bake.node_inputs"):
         former = lut.render.node_inputs
     assert former is lut.render.bake.node_inputs
+
+
+def test_the_polarized_package_imports_mitsuba_only_when_a_plugin_is_registered():
+    """lut.polarized and its Mitsuba modules import without mitsuba or drjit
+    (numpy only until ``register`` or a scene is built)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, lut.polarized, lut.polarized.mitsuba_bsdf, lut.polarized.scenes, lut.polarized.pictures, "
+        "lut.polarized.benchmark; print(sorted(m for m in ('mitsuba', 'drjit') if m in sys.modules))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True)
+    assert done.stdout.strip() == "[]"

@@ -19,6 +19,7 @@ dr = pytest.importorskip("drjit")
 
 from lut import Paint, bench  # noqa: E402
 from lut.polarized import basis, mitsuba_bsdf, mueller_in_transported_basis, mueller_lut  # noqa: E402
+from lut.polarized.scenes import direction, germer_dict, plane_oracle, polarizer_frame  # noqa: E402
 
 VARIANT, WHY = mitsuba_bsdf.choose_variant()
 #: The randomised acceptance set's first eight paints (two smooth, six rough
@@ -43,13 +44,7 @@ def cache(tmp_path_factory):
 
 
 def plugin(paint: Paint, cache: str, **extra):
-    props = {k: paint.to_dict()[k] for k in ("n", "g", "slope", "distribution", "facet")}
-    colours = {"rho": paint.rho[0], "single": paint.single[0]}
-    return mi.load_dict({"type": "germer_paint", **props, **colours, "cache": cache, **extra})
-
-
-def direction(theta, phi):
-    return np.array([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)])
+    return mi.load_dict({**germer_dict(paint, cache), **extra})
 
 
 def model(paint, tl, pl, tv, pv):
@@ -108,40 +103,6 @@ def test_a_coloured_paint_is_weighted_per_wavelength_as_the_paper_weights_rho(ca
     assert not np.allclose(evaluate(bsdf, light, view, 400.0), evaluate(bsdf, light, view, 700.0), rtol=0.05)
 
 
-def oracle(bsdf, light, view, polarizer=None):
-    """S0..S3 (green channel) of a plane under a directional emitter of unit
-    irradiance, seen by an orthographic sensor, through a ``polarizer`` sheet
-    (its angle in degrees) in front of the emitter if given; the Stokes
-    basis is the sensor's (x = the sensor's left)."""
-    scene = {
-        "type": "scene",
-        # volpath carries the emitter's light through the polarizer (a null BSDF).
-        "integrator": {"type": "stokes", "integrator": {"type": "volpath", "max_depth": 2}},
-        "sensor": {
-            "type": "orthographic",
-            "to_world": mi.ScalarTransform4f().look_at(origin=(5 * view).tolist(), target=[0, 0, 0], up=[0, 0, 1])
-            @ mi.ScalarTransform4f().scale([0.1, 0.1, 1.0]),
-            "film": {"type": "hdrfilm", "width": 4, "height": 4, "rfilter": {"type": "box"}, "pixel_format": "rgb"},
-            "sampler": {"type": "stratified", "sample_count": 36},
-        },
-        "plane": {"type": "rectangle", "bsdf": bsdf},
-        "sun": {"type": "directional", "direction": (-light).tolist(), "irradiance": {"type": "rgb", "value": 1.0}},
-    }
-    if polarizer is not None:
-        scene["polarizer"] = {
-            "type": "rectangle",
-            "to_world": polarizer_frame(light) @ mi.ScalarTransform4f().scale([0.3, 0.3, 1.0]),
-            "bsdf": {"type": "polarizer", "theta": {"type": "spectrum", "value": float(polarizer)}},
-        }
-    image = np.array(mi.render(mi.load_dict(scene)))
-    return image.reshape(-1, image.shape[-1]).mean(axis=0)[3:].reshape(4, 3)[:, 1]
-
-
-def polarizer_frame(light):
-    """A sheet one unit towards the light, facing it."""
-    return mi.ScalarTransform4f().look_at(origin=light.tolist(), target=[0, 0, 0], up=[0, 0, 1])
-
-
 def expected_stokes(paint, tl, pl, tv, pv, polarizer=None):
     """The model's Stokes vector at the sensor, in the sensor's basis, of
     unit irradiance: unpolarized, or linearly polarized along the sheet's
@@ -180,11 +141,11 @@ def test_rendered_stokes_vectors_match_the_model(index, cache):
     white = {"type": "diffuse", "reflectance": {"type": "rgb", "value": 1.0}}
     for tl, pl, tv, pv in GEOMETRIES:
         light, view = direction(tl, pl), direction(tv, pv)
-        scale = oracle(white, light, view)[0] / (np.cos(tl) / np.pi)
+        scale = plane_oracle(white, light, view)[0] / (np.cos(tl) / np.pi)
         assert abs(scale - 1.0) < 0.01  # the set-up itself: unit irradiance, a linear sensor
         unpolarized = expected_stokes(paint, tl, pl, tv, pv)
         for polarizer, tolerance in ((None, 0.01), (0.0, 0.015), (45.0, 0.015), (110.0, 0.015)):
-            got = oracle(bsdf, light, view, polarizer) / scale
+            got = plane_oracle(bsdf, light, view, polarizer) / scale
             ref = expected_stokes(paint, tl, pl, tv, pv, polarizer)
             err = np.abs(got - ref).max() / unpolarized[0]
             assert err < tolerance, f"{(tl, pl, tv, pv)}, polarizer {polarizer}: {got} vs {ref}"
@@ -248,3 +209,27 @@ def test_a_variant_that_is_not_polarized_is_refused_with_the_choices():
             mitsuba_bsdf.register()
     finally:
         mi.set_variant(VARIANT)
+
+
+def test_the_polarized_command_writes_stokes_images_and_a_figure(tmp_path, capsys):
+    """``python -m lut polarized``: a preset's sphere with germer_paint and
+    pplastic; the EXRs hold S0..S3 (RGB each), whose luminance is light's
+    (S0 >= |(S1, S2, S3)|), and the figure is written."""
+    import OpenImageIO as oiio
+
+    from lut.__main__ import main
+
+    assert main(["polarized", "--preset", "glossy_red", "--out", str(tmp_path), "--size", "16", "--spp", "2"]) == 0
+    out = capsys.readouterr().out
+    assert "germer_paint: rendered" in out and "pplastic: rendered" in out
+    assert (tmp_path / "glossy_red-polarized.png").stat().st_size > 10_000
+    for kind in ("germer_paint", "pplastic"):
+        image = oiio.ImageInput.open(str(tmp_path / f"glossy_red-stokes-{kind}.exr"))
+        assert image.spec().channelnames[:4] == ("S0.R", "S0.G", "S0.B", "S1.R")
+        pixels = image.read_image("float").reshape(16, 16, 4, 3)
+        image.close()
+        # Luminance: CIE ȳ weighs every wavelength positively (an sRGB
+        # channel does not), so the Stokes vectors of Y are those of real light.
+        y = pixels @ np.array([0.2126, 0.7152, 0.0722])
+        assert y[:, :, 0].max() > 0.0
+        assert np.all(np.sqrt((y[:, :, 1:] ** 2).sum(axis=2)) <= y[:, :, 0] * (1 + 1e-3) + 1e-6)
