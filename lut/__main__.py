@@ -4,6 +4,7 @@
     python -m lut bake --preset NAME [...]    bake one paint into a LUT file
     python -m lut info FILE [FILE ...]        describe LUT files
     python -m lut clean DIR --keep FILE ...   remove the LUTs and weights in DIR that nothing uses
+    python -m lut polarized --preset NAME     render a preset's sphere polarized with Mitsuba 3 (beside pplastic)
 
 Errors are reported as one line on standard error, with exit status 2
 (130 when interrupted with Ctrl-C)."""
@@ -272,6 +273,41 @@ def _cmd_clean(args) -> int:
     return 0
 
 
+#: The polarized command's limits: image side in pixels, samples per pixel.
+POLARIZED_SIZE = (8, 2048)
+POLARIZED_SPP = (1, 4096)
+
+
+def _cmd_polarized(args) -> int:
+    """Render a preset's sphere polarized (``lut.polarized.pictures``)."""
+    for name, value, (low, high) in (("size", args.size, POLARIZED_SIZE), ("spp", args.spp, POLARIZED_SPP)):
+        if not low <= value <= high:
+            raise ValueError(f"--{name} must be an integer in [{low}, {high}], got {value}")
+    try:
+        import mitsuba  # noqa: F401
+    except ImportError:
+        raise ValueError(
+            "the polarized command needs Mitsuba 3, which is in its own environment: run "
+            "`.venv-mitsuba/bin/python -m lut polarized ...` (scripts/bootstrap.sh makes .venv-mitsuba)"
+        ) from None
+    from .polarized import mitsuba_bsdf, pictures
+
+    out = pathlib.Path(args.out)
+    _check_out(out)
+    variant, why = mitsuba_bsdf.choose_variant()
+    print(why)
+    paint = presets.preset(args.preset)
+    rendered = pictures.render(
+        paint, size=args.size, spp=args.spp, cache=out / "mueller", pplastic=not args.no_pplastic, variant=variant
+    )
+    for name, seconds in rendered["seconds"].items():
+        print(f"  {name}: rendered in {seconds:.2f} s ({args.size}x{args.size}, {args.spp} spp)")
+    title = f"{args.preset}: a sphere under a sun and a sky, {variant}"
+    for path in pictures.write(out, args.preset, rendered, title):
+        print(path)
+    return 0
+
+
 def _cmd_example(args) -> int:
     try:  # development modules: the extension's wheel leaves them out
         from . import examples, figures
@@ -372,6 +408,19 @@ def build_parser() -> argparse.ArgumentParser:
     )
     clean.add_argument("--dry-run", action="store_true", help="only list what would be removed")
 
+    pol = sub.add_parser(
+        "polarized",
+        help="render a preset's sphere polarized with Mitsuba 3, beside Mitsuba's pplastic (needs .venv-mitsuba)",
+        description="Render a sphere of a preset paint under a sun and a sky with the Mitsuba 3 plugin germer_paint "
+        "(and with Mitsuba's pplastic given the same paint), and write its Stokes images (EXR, S0..S3) and one "
+        "figure: S0, the degree of linear polarization and its angle.  Runs in .venv-mitsuba.",
+    )
+    pol.add_argument("--preset", choices=list(presets.PRESETS), default="green_carc", help="default: %(default)s")
+    pol.add_argument("--out", default=str(pathlib.Path(DEFAULT_OUT) / "polarized"), help="default: %(default)s")
+    pol.add_argument("--size", type=int, default=128, help="image side in pixels (default: %(default)s)")
+    pol.add_argument("--spp", type=int, default=16, help="samples per pixel (default: %(default)s)")
+    pol.add_argument("--no-pplastic", action="store_true", help="render germer_paint only")
+
     return parser
 
 
@@ -389,7 +438,13 @@ def main(argv=None) -> int:
                         parser.bake_parser.error(f"--{key} takes one grey value, three RGB values or one spectrum")
             elif value is not None:
                 parser.bake_parser.error(f"--{key} takes one grey value, three RGB values or one spectrum")
-    command = {"example": _cmd_example, "bake": _cmd_bake, "info": _cmd_info, "clean": _cmd_clean}[args.command]
+    command = {
+        "example": _cmd_example,
+        "bake": _cmd_bake,
+        "info": _cmd_info,
+        "clean": _cmd_clean,
+        "polarized": _cmd_polarized,
+    }[args.command]
     try:
         return command(args)
     except (ValueError, OSError) as exc:

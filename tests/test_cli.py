@@ -60,12 +60,27 @@ def test_bake_from_options_toml_and_json_then_info(tmp_path, capsys):
         (["bake", "--slope", "-1"], "error: slope must be a finite real number >= 0"),
         (["bake", "--paint", "missing.toml"], "error: cannot read paint file 'missing.toml'"),
         (["info", "missing.exr"], "error: missing.exr: no such LUT file"),
+        (["polarized", "--size", "4"], "error: --size must be an integer in [8, 2048], got 4"),
+        (["polarized", "--spp", "0"], "error: --spp must be an integer in [1, 4096], got 0"),
     ],
 )
 def test_errors_are_one_line(argv, message, tmp_path, capsys):
-    assert main([*argv[:1], *argv[1:], *(["--out", str(tmp_path)] if argv[0] == "bake" else [])]) == 2
+    out = ["--out", str(tmp_path)] if argv[0] in ("bake", "polarized") else []
+    assert main([*argv[:1], *argv[1:], *out]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith(message) and "\n" not in err
+
+
+def test_the_polarized_command_says_where_mitsuba_is_when_it_is_not_here(tmp_path, capsys):
+    try:
+        import mitsuba  # noqa: F401
+    except ImportError:
+        pass
+    else:
+        pytest.skip("mitsuba is installed here (tests/test_mitsuba_plugin.py runs the command)")
+    assert main(["polarized", "--out", str(tmp_path), "--size", "8"]) == 2
+    assert ".venv-mitsuba/bin/python -m lut polarized" in capsys.readouterr().err
+    assert not any(tmp_path.iterdir())  # nothing written
 
 
 def test_bad_toml_and_help(tmp_path, capsys):
