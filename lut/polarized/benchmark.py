@@ -1,0 +1,74 @@
+"""Measurements of the Mitsuba plugin (``scripts/benchmark_mitsuba.py`` is
+the command): the Mueller LUT's bake time and size, the render time of a
+scene with ``germer_paint`` against the same scene with Mitsuba's
+``pplastic`` given the same paint (the same variant), and the two side by
+side with the models on the plane oracle.  Needs mitsuba."""
+
+from __future__ import annotations
+
+import pathlib
+import tempfile
+import time
+
+import numpy as np
+
+from ..paint.core import Paint
+from . import basis, mueller_in_transported_basis, mueller_lut, scenes
+
+
+def bake_cost(paint: Paint) -> dict:
+    """Seconds and megabytes of a fresh Mueller LUT bake of the paint's type
+    (default resolution)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        start = time.perf_counter()
+        path = mueller_lut.bake_mueller(paint, tmp, force=True)
+        seconds = time.perf_counter() - start
+        size = pathlib.Path(path).stat().st_size
+    return {"seconds": seconds, "megabytes": size / 1e6}
+
+
+def render_ratio(paint: Paint, *, size=64, spp=8, cache=None, variant=None) -> dict:
+    """Render seconds of the sphere scene (``scenes.sphere_scene``) with
+    germer_paint and with pplastic, and their ratio."""
+    from . import pictures
+
+    rendered = pictures.render(paint, size=size, spp=spp, cache=cache, variant=variant)
+    seconds = rendered["seconds"]
+    return {**seconds, "ratio": seconds["germer_paint"] / seconds["pplastic"], "variant": rendered["variant"]}
+
+
+def _model_stokes(paint, light, view):
+    """The models' Stokes vector (green channel) at the plane oracle's sensor,
+    unpolarized light of unit irradiance."""
+    tl, tv = np.arccos(light[2]), np.arccos(view[2])
+    pl, pv = np.arctan2(light[1], light[0]), np.arctan2(view[1], view[0])
+    ps = pv - pl + np.pi
+    m = mueller_in_transported_basis(paint.mueller(tl, tv, ps)[1], tl, tv, ps, pl - np.pi) * np.cos(tl)
+    left = np.cross([0.0, 0.0, 1.0], -view)
+    s_out, p_out = basis.transported_basis(view)
+    return basis.stokes_rotation(basis.turn(view, s_out, p_out, left / np.linalg.norm(left))) @ m[:, 0]
+
+
+def side_by_side(paint: Paint, geometries, *, cache=None) -> list[dict]:
+    """Per geometry (θl, φl, θv, φv in degrees, the plane oracle's, unpolarized
+    sun): S0 and the degree of linear polarization (green channel) of the
+    models, germer_paint and pplastic.  The renderer's white (its Lambertian
+    in the same set-up) is divided out of the renders."""
+    import mitsuba as mi
+
+    germer, pplastic = mi.load_dict(scenes.germer_dict(paint, cache)), mi.load_dict(scenes.pplastic_dict(paint))
+    white = mi.load_dict({"type": "diffuse", "reflectance": {"type": "rgb", "value": 1.0}})
+    rows = []
+    for tl, pl, tv, pv in geometries:
+        light = scenes.direction(*np.radians([tl, pl]))
+        view = scenes.direction(*np.radians([tv, pv]))
+        scale = scenes.plane_oracle(white, light, view)[0] / (light[2] / np.pi)
+        row = {"geometry": (tl, pl, tv, pv)}
+        for name, stokes in (
+            ("model", _model_stokes(paint, light, view)),
+            ("germer_paint", scenes.plane_oracle(germer, light, view) / scale),
+            ("pplastic", scenes.plane_oracle(pplastic, light, view) / scale),
+        ):
+            row[name] = {"S0": float(stokes[0]), "DoLP": float(np.hypot(stokes[1], stokes[2]) / stokes[0])}
+        rows.append(row)
+    return rows
