@@ -58,6 +58,7 @@ not offered here: their LUT has one tile per RGB channel.
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import pathlib
@@ -66,7 +67,7 @@ import sys
 
 import numpy as np
 
-from ..models._validate import check_range
+from ..models._validate import REFLECTANCE, check_range
 from ..paint.core import Paint
 from ..paint.schema import PAINT_FIELDS
 from . import mueller_lut
@@ -114,10 +115,17 @@ _PROBE_RENDER = (
 )
 
 
+@functools.lru_cache(maxsize=8)
 def choose_variant(candidates=VARIANTS) -> tuple[str, str]:
-    """(variant, why): the first polarized variant that loads in a child
-    process (``DRJIT_LIBLLVM_PATH`` is honoured there), and a sentence that
-    says which was taken and why the ones before it were not."""
+    """(variant, why): ``$PAINT_LUT_MITSUBA_VARIANT`` if set, else the first
+    polarized variant that renders a tiny scene in a child process
+    (``DRJIT_LIBLLVM_PATH`` is honoured there: Dr.Jit reads it when first
+    imported, so set it before importing mitsuba), and a sentence that says
+    which was taken and why the ones before it were not.  Probed once per
+    process."""
+    chosen = os.environ.get("PAINT_LUT_MITSUBA_VARIANT")
+    if chosen:
+        return chosen, f"Mitsuba variant {chosen} (PAINT_LUT_MITSUBA_VARIANT)"
     skipped = []
     for variant in candidates:
         probe = f"import mitsuba as mi; mi.set_variant({variant!r}); {_PROBE_RENDER}"
@@ -162,8 +170,14 @@ def type_paint(n=None, g=None, slope=None, distribution=None, facet=None) -> Pai
     fields = {"n": n, "g": g, "slope": slope, "distribution": distribution, "facet": facet}
     fields = {k: v for k, v in fields.items() if v is not None}
     for name, value in fields.items():
-        allowed = PAINT_FIELDS[name].bake  # what a LUT can hold, as the command line's bakes
-        if allowed is not None and not (name == "slope" and value == 0):
+        spec = PAINT_FIELDS[name]
+        if spec.choices:
+            if value not in spec.choices:
+                choices = ", ".join(repr(c) for c in spec.choices)
+                raise ValueError(f"germer_paint property {name} must be one of {choices}, got {value!r}")
+            continue
+        allowed = spec.bake or spec.allowed  # what a LUT can hold, as the command line's bakes
+        if not (name == "slope" and value == 0):
             check_range(value, f"germer_paint property {name}", allowed)
     paint = Paint(**fields)
     if paint.dispersive:
@@ -187,15 +201,33 @@ def _bsdf_class():
         b = mi.mueller.stokes_basis(local)
         return mi.Vector3f(c * b.x - s * b.y, s * b.x + c * b.y, b.z)
 
+    def colour_texture(props, name):
+        """A colour property as a texture, its values within [0, 1] (a float
+        is checked exactly, a texture by its largest value)."""
+        if name not in props:
+            return mi.load_dict({"type": "uniform", "value": float(np.mean(PAINT_FIELDS[name].default))})
+        if props.type(name) == mi.Properties.Type.Float:
+            check_range(props.get(name), f"germer_paint property {name}", REFLECTANCE)
+        texture = props.get_texture(name)
+        if float(texture.max()) > 1.0 + 1e-6:
+            raise ValueError(
+                f"germer_paint property {name} must be a colour with values in [0, 1], its largest is {texture.max():g}"
+            )
+        return texture
+
     class GermerPaint(mi.BSDF):
         def __init__(self, props):
             mi.BSDF.__init__(self, props)
             get = props.get
             fields = {key: get(key) for key in ("n", "g", "slope", "distribution", "facet") if key in props}
             self.paint = type_paint(**fields)
-            self.rho = props.get_texture("rho", float(np.mean(PAINT_FIELDS["rho"].default)))
-            self.single = props.get_texture("single", float(np.mean(PAINT_FIELDS["single"].default)))
-            cache = pathlib.Path(str(get("cache"))) if "cache" in props else default_cache()
+            self.rho = colour_texture(props, "rho")
+            self.single = colour_texture(props, "single")
+            if "cache" in props and props.type("cache") != mi.Properties.Type.String:
+                raise ValueError(
+                    f"germer_paint property cache must be a directory path (a string), got {get('cache')!r}"
+                )
+            cache = pathlib.Path(get("cache")) if "cache" in props else default_cache()
             path = mueller_lut.bake_mueller(self.paint, cache)
             table = mueller_lut.load_mueller_lut(path)
             self.lut_path = str(path)
@@ -299,6 +331,8 @@ def _bsdf_class():
             return dr.clip(r, *MIRROR_CHOICE)
 
         def _pdf(self, ctx, si, wo, active):
+            if not ctx.is_enabled(self.lobe, 0):
+                return mi.Float(0.0)  # only the mirror (a delta) is asked for
             cos_i, cos_o = mi.Frame3f.cos_theta(si.wi), mi.Frame3f.cos_theta(wo)
             pdf = mi.warp.square_to_cosine_hemisphere_pdf(wo)
             if not self.smooth:
