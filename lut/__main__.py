@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import importlib.util
 import json
 import math
 import os
@@ -283,23 +284,24 @@ def _cmd_polarized(args) -> int:
     for name, value, (low, high) in (("size", args.size, POLARIZED_SIZE), ("spp", args.spp, POLARIZED_SPP)):
         if not low <= value <= high:
             raise ValueError(f"--{name} must be an integer in [{low}, {high}], got {value}")
-    try:
-        import mitsuba  # noqa: F401
-    except ImportError:
+    if importlib.util.find_spec("mitsuba") is None:  # not imported: DRJIT_LIBLLVM_PATH is read at import
         raise ValueError(
             "the polarized command needs Mitsuba 3, which is in its own environment: run "
             "`.venv-mitsuba/bin/python -m lut polarized ...` (scripts/bootstrap.sh makes .venv-mitsuba)"
-        ) from None
+        )
     from .polarized import mitsuba_bsdf, pictures
 
     out = pathlib.Path(args.out)
     _check_out(out)
-    variant, why = mitsuba_bsdf.choose_variant()
-    print(why)
-    paint = presets.preset(args.preset)
-    rendered = pictures.render(
-        paint, size=args.size, spp=args.spp, cache=out / "mueller", pplastic=not args.no_pplastic, variant=variant
-    )
+    try:
+        variant, why = mitsuba_bsdf.choose_variant()
+        print(why)
+        paint = presets.preset(args.preset)
+        rendered = pictures.render(
+            paint, size=args.size, spp=args.spp, cache=out / "mueller", pplastic=not args.no_pplastic, variant=variant
+        )
+    except RuntimeError as exc:  # Mitsuba reports its own and its plugins' errors as RuntimeError
+        raise ValueError(str(exc).strip().splitlines()[-1]) from None
     for name, seconds in rendered["seconds"].items():
         print(f"  {name}: rendered in {seconds:.2f} s ({args.size}x{args.size}, {args.spp} spp)")
     title = f"{args.preset}: a sphere under a sun and a sky, {variant}"

@@ -2,8 +2,9 @@
 Mitsuba 3 (``lut.polarized.scenes.sphere_scene``) with ``germer_paint`` and,
 beside it, Mitsuba's ``pplastic`` given the same paint; written as the
 Stokes images (an EXR of S0..S3, RGB each) and one figure per paint: S0
-(sRGB), the degree of linear polarization, and its angle on a colour wheel
-(hue the angle, brightness the degree).  Needs mitsuba (``.venv-mitsuba``);
+(sRGB), the degree of linear polarization and its angle of luminance Y
+(``scenes.luminance``), the angle on a colour wheel (hue the angle,
+brightness the degree).  Spectral polarized variants.  Needs mitsuba (``.venv-mitsuba``);
 ``python -m lut polarized`` is its command."""
 
 from __future__ import annotations
@@ -64,8 +65,11 @@ DOLP_FULL = 0.5
 
 
 def write(directory, name: str, rendered: dict, title: str) -> list[pathlib.Path]:
-    """Write ``<name>-stokes-<bsdf>.exr`` per BSDF and ``<name>-polarized.png``
-    (rows: the BSDFs; columns: S0, degree, angle, and a colour wheel), each
+    """Write per BSDF ``<name>-stokes-<bsdf>.exr`` (S0..S3, RGB each) and the
+    degree and angle of linear polarization of luminance as pictures
+    (``<name>-dolp-<bsdf>.png``, magma over [0, 1]; ``<name>-aolp-<bsdf>.png``,
+    hue the angle, brightness the degree), and ``<name>-polarized.png`` (rows:
+    the BSDFs; columns: S0, degree, angle, and a colour wheel), each
     atomically.  Returns the paths."""
     import matplotlib
 
@@ -88,17 +92,23 @@ def write(directory, name: str, rendered: dict, title: str) -> list[pathlib.Path
             if out is None or not out.open(tmp, spec) or not out.write_image(pixels) or not out.close():
                 raise OSError(f"cannot write {path}: {oiio.geterror()}")
         paths.append(path)
+        dolp, aolp = scenes.degree_and_angle(scenes.luminance(stokes))
+        for what, picture in (("dolp", plt.get_cmap("magma")(dolp)[..., :3]), ("aolp", angle_colours(dolp, aolp))):
+            path = directory / f"{name}-{what}-{kind}.png"
+            with atomic_target(path) as tmp:
+                plt.imsave(tmp, np.clip(picture, 0.0, 1.0), format="png")
+            paths.append(path)
     fig, axes = plt.subplots(len(kinds), 4, figsize=(11, 2.9 * len(kinds)), squeeze=False)
     scale = max(float(np.percentile(rendered[k][0], 99.5)) for k in kinds) or 1.0
     for row, kind in zip(axes, kinds, strict=True):
         stokes = rendered[kind]
-        dolp, aolp = scenes.degree_and_angle(stokes[..., 1])  # green channel
+        dolp, aolp = scenes.degree_and_angle(scenes.luminance(stokes))
         seconds = rendered.get("seconds", {}).get(kind)
         label = kind + (f" ({seconds:.1f} s)" if seconds is not None else "")
         row[0].imshow(_srgb(stokes[0] / scale))
         row[0].set_title(f"{label}: S0", fontsize=9)
         shown = row[1].imshow(dolp, cmap="magma", vmin=0.0, vmax=1.0)
-        row[1].set_title("degree of linear polarization", fontsize=9)
+        row[1].set_title("degree of linear polarization (Y)", fontsize=9)
         fig.colorbar(shown, ax=row[1], fraction=0.046)
         row[2].imshow(angle_colours(dolp, aolp))
         row[2].set_title(f"angle (brightness: degree, full at {DOLP_FULL:g})", fontsize=9)

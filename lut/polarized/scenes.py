@@ -86,7 +86,8 @@ def polarizer_frame(light):
 
 
 def plane_oracle(bsdf, light, view, polarizer=None, spp=36, size=4) -> np.ndarray:
-    """(S0, S1, S2, S3), green channel, of a plane under a directional
+    """(S0, S1, S2, S3), green channel (of a grey paint, every channel is the
+    same light), of a plane under a directional
     emitter of unit irradiance from ``light`` (unit, towards it), seen by an
     orthographic sensor from ``view``, through a ``polarizer`` sheet (its
     angle, degrees) in front of the emitter if given; the Stokes basis is the
@@ -150,10 +151,26 @@ def sphere_scene(bsdf, size=128, spp=16, sun=(40.0, 30.0), sky=0.15, max_depth=3
 
 
 def stokes_images(image) -> np.ndarray:
-    """(4, H, W, 3): S0..S3 (RGB) of a ``stokes`` render (its channels R, G,
-    B, then S0..S3 as RGB each)."""
+    """(4, H, W, 3): S0..S3 (RGB) of a ``stokes`` render in a spectral variant
+    (its channels R, G, B, then S0..S3 as RGB each)."""
     image = np.asarray(image)
+    if image.ndim != 3 or image.shape[-1] < 15:
+        raise ValueError(
+            f"a stokes render of a spectral variant has 15 or more channels (RGB, then S0..S3 as RGB), got shape "
+            f"{image.shape}"
+        )
     return np.moveaxis(image[..., 3:15].reshape(image.shape[:2] + (4, 3)), 2, 0)
+
+
+#: Rec. 709 luminance of linear sRGB: CIE ȳ, which weighs every wavelength
+#: positively, so the Stokes vectors of Y are those of real light (an sRGB
+#: channel's weights go negative and its "degree of polarization" can pass 1).
+LUMINANCE = np.array([0.2126, 0.7152, 0.0722])
+
+
+def luminance(stokes) -> np.ndarray:
+    """(4, ...) Stokes images of luminance Y from RGB ones (4, ..., 3)."""
+    return np.asarray(stokes) @ LUMINANCE
 
 
 def degree_and_angle(stokes) -> tuple[np.ndarray, np.ndarray]:
