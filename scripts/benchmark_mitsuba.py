@@ -45,9 +45,9 @@ def main(argv=None):
             times = benchmark.render_ratio(paint, size=size, spp=spp, cache=cache, variant=variant)
             print(
                 f"| {name} | {bake['seconds']:.2f} s | {bake['megabytes']:.1f} MB | {times['germer_paint']:.2f} s"
-                f" | {times['pplastic']:.3f} s | {times['ratio']:.0f}x |"
+                f" | {times['pplastic']:.3f} s | {times['ratio']:.1f}x |"
             )
-        print(f"\n(sphere {size}x{size}, {spp} spp, {variant})")
+        print(f"\n(sphere {size}x{size}, {spp} spp, {variant}; the second render of each scene timed)")
         columns = "S0 model | germer_paint | pplastic | DoLP model | germer_paint | pplastic"
         print(f"\n| preset | θl, φl, θv, φv | {columns} |")
         print("|---|---|---|---|---|---|---|---|")
