@@ -18,8 +18,8 @@ mi = pytest.importorskip("mitsuba")
 dr = pytest.importorskip("drjit")
 
 from lut import Paint, bench  # noqa: E402
-from lut.polarized import basis, mitsuba_bsdf, mueller_in_transported_basis, mueller_lut  # noqa: E402
-from lut.polarized.scenes import direction, germer_dict, plane_oracle, polarizer_frame  # noqa: E402
+from lut.polarized import mitsuba_bsdf, mueller_lut  # noqa: E402
+from lut.polarized.scenes import direction, germer_dict, model_mueller, model_stokes, plane_oracle  # noqa: E402
 
 VARIANT, WHY = mitsuba_bsdf.choose_variant()
 #: The randomised acceptance set's first eight paints (two smooth, six rough
@@ -48,12 +48,9 @@ def plugin(paint: Paint, cache: str, **extra):
 
 
 def model(paint, tl, pl, tv, pv):
-    """The model's Mueller matrix x cos θl of light from (θl, φl) seen from
-    (θv, φv) in the shading frame, in Mitsuba's Stokes bases there (the
-    transported bases of that frame: the models' frame turned by φl − π)."""
-    ps = pv - pl + np.pi
-    m = paint.mueller(tl, tv, ps)[..., 0, :, :]
-    return mueller_in_transported_basis(m, tl, tv, ps, pl - np.pi) * np.cos(tl)[..., None, None]
+    """The model's Mueller matrix x cos θl in Mitsuba's Stokes bases of the
+    shading frame (grey paints: one channel is every channel)."""
+    return model_mueller(paint, tl, pl, tv, pv, channel=0)
 
 
 def vector(v):
@@ -145,23 +142,8 @@ def test_a_coloured_paint_is_weighted_per_wavelength_as_the_paper_weights_rho(ca
 
 
 def expected_stokes(paint, tl, pl, tv, pv, polarizer=None):
-    """The model's Stokes vector at the sensor, in the sensor's basis, of
-    unit irradiance: unpolarized, or linearly polarized along the sheet's
-    transmission axis (its local x turned by −θ about the light's
-    direction of travel)."""
-    light, view = direction(tl, pl), direction(tv, pv)
-    m = model(paint, np.array(tl), pl, np.array(tv), pv)
-    s_in = np.array([1.0, 0.0, 0.0, 0.0])
-    if polarizer is not None:
-        k = -light
-        s, p = basis.transported_basis(k)
-        axis = np.array(polarizer_frame(light) @ mi.ScalarVector3f(1.0, 0.0, 0.0))
-        chi = np.arctan2(axis @ p, axis @ s) - np.radians(polarizer)
-        s_in = 0.5 * np.array([1.0, np.cos(2 * chi), np.sin(2 * chi), 0.0])
-    left = np.cross([0.0, 0.0, 1.0], -view)
-    s_out, p_out = basis.transported_basis(view)
-    to_sensor = basis.stokes_rotation(basis.turn(view, s_out, p_out, left / np.linalg.norm(left)))
-    return to_sensor @ m @ s_in
+    """The model's Stokes vector at the plane oracle's sensor, in its basis."""
+    return model_stokes(paint, tl, pl, tv, pv, polarizer, channel=0)
 
 
 GEOMETRIES = [(0.5, 0.3, 0.7, 2.0), (1.2, -1.0, 0.3, 0.5), (0.2, 0.0, 1.1, 3.0), (1.25, 2.0, 1.25, -1.1)]

@@ -13,7 +13,7 @@ import time
 import numpy as np
 
 from ..paint.core import Paint
-from . import basis, mueller_in_transported_basis, mueller_lut, scenes
+from . import mueller_lut, scenes
 
 
 def bake_cost(paint: Paint) -> dict:
@@ -40,18 +40,6 @@ def render_ratio(paint: Paint, *, size=64, spp=8, cache=None, variant=None) -> d
     return {**seconds, "ratio": seconds["germer_paint"] / seconds["pplastic"], "variant": rendered["variant"]}
 
 
-def _model_stokes(paint, light, view):
-    """The models' Stokes vector (green channel) at the plane oracle's sensor,
-    unpolarized light of unit irradiance."""
-    tl, tv = np.arccos(light[2]), np.arccos(view[2])
-    pl, pv = np.arctan2(light[1], light[0]), np.arctan2(view[1], view[0])
-    ps = pv - pl + np.pi
-    m = mueller_in_transported_basis(paint.mueller(tl, tv, ps)[1], tl, tv, ps, pl - np.pi) * np.cos(tl)
-    left = np.cross([0.0, 0.0, 1.0], -view)
-    s_out, p_out = basis.transported_basis(view)
-    return basis.stokes_rotation(basis.turn(view, s_out, p_out, left / np.linalg.norm(left))) @ m[:, 0]
-
-
 def side_by_side(paint: Paint, geometries, *, cache=None) -> list[dict]:
     """Per geometry (θl, φl, θv, φv in degrees, the plane oracle's, unpolarized
     sun): S0 and the degree of linear polarization (green channel) of the
@@ -68,7 +56,7 @@ def side_by_side(paint: Paint, geometries, *, cache=None) -> list[dict]:
         scale = scenes.plane_oracle(white, light, view)[0] / (light[2] / np.pi)
         row = {"geometry": (tl, pl, tv, pv)}
         for name, stokes in (
-            ("model", _model_stokes(paint, light, view)),
+            ("model", scenes.model_stokes(paint, *np.radians([tl, pl, tv, pv]))),
             ("germer_paint", scenes.plane_oracle(germer, light, view) / scale),
             ("pplastic", scenes.plane_oracle(pplastic, light, view) / scale),
         ):

@@ -14,6 +14,7 @@ import numpy as np
 
 from ..colour import management as cm
 from ..paint.core import Paint
+from . import basis
 from .mitsuba_bsdf import PLUGIN
 
 
@@ -119,6 +120,40 @@ def plane_oracle(bsdf, light, view, polarizer=None, spp=36, size=4) -> np.ndarra
         }
     image = np.array(mi.render(mi.load_dict(scene)))
     return image.reshape(-1, image.shape[-1]).mean(axis=0)[3:].reshape(4, 3)[:, 1]
+
+
+def model_mueller(paint: Paint, theta_l, phi_l, theta_v, phi_v, channel=1) -> np.ndarray:
+    """The models' Mueller matrix × cos θl (one RGB ``channel``) of light from
+    (θl, φl) seen from (θv, φv) in a shading frame (radians, broadcast), in
+    Mitsuba's Stokes bases there: the transported bases of that frame, the
+    models' frame turned by φl − π (``basis.mueller_in_transported_basis``)."""
+    theta_l, theta_v = np.asarray(theta_l, float), np.asarray(theta_v, float)
+    phi_s = phi_v - phi_l + np.pi
+    m = paint.mueller(theta_l, theta_v, phi_s)[..., channel, :, :]
+    return (
+        basis.mueller_in_transported_basis(m, theta_l, theta_v, phi_s, phi_l - np.pi) * np.cos(theta_l)[..., None, None]
+    )
+
+
+def model_stokes(paint: Paint, theta_l, phi_l, theta_v, phi_v, polarizer=None, channel=1) -> np.ndarray:
+    """What ``plane_oracle`` renders, from the models: the Stokes vector at the
+    sensor, in its basis (x = its left), of unit irradiance, unpolarized or
+    through the ``polarizer`` sheet (degrees: linearly polarized along the
+    sheet's local x turned by −θ about the light's direction of travel)."""
+    light, view = direction(theta_l, phi_l), direction(theta_v, phi_v)
+    m = model_mueller(paint, theta_l, phi_l, theta_v, phi_v, channel)
+    s_in = np.array([1.0, 0.0, 0.0, 0.0])
+    if polarizer is not None:
+        import mitsuba as mi
+
+        s, p = basis.transported_basis(-light)
+        axis = np.array(polarizer_frame(light) @ mi.ScalarVector3f(1.0, 0.0, 0.0))
+        chi = np.arctan2(axis @ p, axis @ s) - np.radians(polarizer)
+        s_in = 0.5 * np.array([1.0, np.cos(2 * chi), np.sin(2 * chi), 0.0])
+    left = np.cross([0.0, 0.0, 1.0], -view)
+    s_out, p_out = basis.transported_basis(view)
+    to_sensor = basis.stokes_rotation(basis.turn(view, s_out, p_out, left / np.linalg.norm(left)))
+    return to_sensor @ m @ s_in
 
 
 def sphere_scene(bsdf, size=128, spp=16, sun=(40.0, 30.0), sky=0.15, max_depth=3) -> dict:
