@@ -81,6 +81,7 @@ def write(directory, name: str, rendered: dict, title: str) -> list[pathlib.Path
     directory.mkdir(parents=True, exist_ok=True)
     kinds = [k for k in ("germer_paint", "pplastic") if k in rendered]
     paths = []
+    polarization = {k: scenes.degree_and_angle(scenes.luminance(rendered[k])) for k in kinds}
     for kind in kinds:
         stokes = rendered[kind]
         pixels = np.ascontiguousarray(np.moveaxis(stokes, 0, 2).reshape(stokes.shape[1:3] + (12,)), np.float32)
@@ -92,7 +93,7 @@ def write(directory, name: str, rendered: dict, title: str) -> list[pathlib.Path
             if out is None or not out.open(tmp, spec) or not out.write_image(pixels) or not out.close():
                 raise OSError(f"cannot write {path}: {oiio.geterror()}")
         paths.append(path)
-        dolp, aolp = scenes.degree_and_angle(scenes.luminance(stokes))
+        dolp, aolp = polarization[kind]
         for what, picture in (("dolp", plt.get_cmap("magma")(dolp)[..., :3]), ("aolp", angle_colours(dolp, aolp))):
             path = directory / f"{name}-{what}-{kind}.png"
             with atomic_target(path) as tmp:
@@ -102,7 +103,7 @@ def write(directory, name: str, rendered: dict, title: str) -> list[pathlib.Path
     scale = max(float(np.percentile(rendered[k][0], 99.5)) for k in kinds) or 1.0
     for row, kind in zip(axes, kinds, strict=True):
         stokes = rendered[kind]
-        dolp, aolp = scenes.degree_and_angle(scenes.luminance(stokes))
+        dolp, aolp = polarization[kind]
         seconds = rendered.get("seconds", {}).get(kind)
         label = kind + (f" ({seconds:.1f} s)" if seconds is not None else "")
         row[0].imshow(_srgb(stokes[0] / scale))
