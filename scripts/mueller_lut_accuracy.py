@@ -5,8 +5,10 @@ on the randomised set (``lut.bench.random_paints``, fixed seed).
 
 Prints per paint, from ``mueller_lut.accuracy``: M00's and the worst other
 element's cos θi-weighted RMS error relative to M00 (θi, θs <= 80°, all
-azimuths), the worst pointwise error at the poles (M00, and any other
-element relative to M00), the bake time (a cache hit is baked again) and the
+azimuths), the largest error of Mij/M00 there, the worst pointwise error at
+the poles (M00, and any other element relative to M00); the first three
+again with the facet term in closed form (``closed_facet``, as the Mitsuba
+plugin evaluates it); the bake time (a cache hit is baked again) and the
 file's size; then the worst and the median of each column."""
 
 from __future__ import annotations
@@ -33,27 +35,34 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as tmp:
         directory = args.directory or pathlib.Path(tmp)
         rows = []
-        print(
-            f"{'paint':28s} {'M00 rms':>8s} {'other':>8s} {'pole M00':>9s} {'pole oth':>9s} {'bake s':>7s} {'MB':>5s}"
-        )
+        columns = ("M00 rms", "other", "Mij/M00", "pole M00", "pole oth", "M00 rms", "other", "Mij/M00")
+        print(f"{'':28s} {'the table':^44s}  {'facet in closed form':^26s}")
+        print(f"{'paint':28s} " + " ".join(f"{c:>8s}" for c in columns) + f" {'bake s':>7s} {'MB':>5s}")
         for label, paint in bench.random_paints(args.count):
             start = time.perf_counter()
             path = mueller_lut.bake_mueller(paint, directory, force=True)
             seconds = time.perf_counter() - start
-            found = mueller_lut.accuracy(mueller_lut.load_mueller_lut(path), paint)
-            rms = found["rms"].copy()
-            m00 = rms[0, 0]
-            rms[0, 0] = 0.0
-            row = (100 * m00, 100 * rms.max(), 100 * found["poles_m00"], 100 * found["poles"], seconds,
-                   path.stat().st_size / 1e6)  # fmt: skip
-            rows.append(row)
-            print(
-                f"{label:28s} {row[0]:7.2f}% {row[1]:7.2f}% {row[2]:8.2f}% {row[3]:8.2f}% {row[4]:7.1f} {row[5]:5.1f}"
-            )
+            table = mueller_lut.load_mueller_lut(path)
+            row = []
+            for closed in (False, True):
+                found = mueller_lut.accuracy(table, paint, closed_facet=closed)
+                rms = found["rms"].copy()
+                m00 = rms[0, 0]
+                rms[0, 0] = 0.0
+                row += [100 * m00, 100 * rms.max(), found["normalised"]]
+                if not closed:
+                    row += [100 * found["poles_m00"], 100 * found["poles"]]
+            rows.append(row + [seconds, path.stat().st_size / 1e6])
+            print(f"{label:28s} " + _cells(rows[-1]))
         rows = np.array(rows)
         for name, value in (("worst", rows.max(axis=0)), ("median", np.median(rows, axis=0))):
-            print(f"{name:28s} " + " ".join(f"{v:7.2f}%" for v in value[:2]) + " "
-                  + " ".join(f"{v:8.2f}%" for v in value[2:4]) + f" {value[4]:7.1f} {value[5]:5.1f}")  # fmt: skip
+            print(f"{name:28s} " + _cells(value))
+
+
+def _cells(row) -> str:
+    """A row of the table: per cent, the Mij/M00 errors as they are, seconds, MB."""
+    cells = [f"{v:7.2f}%" if k not in (2, 7) else f"{v:8.4f}" for k, v in enumerate(row[:8])]
+    return " ".join(cells) + f" {row[8]:7.1f} {row[9]:5.1f}"
 
 
 if __name__ == "__main__":

@@ -17,12 +17,31 @@ through the normal and the half vector has the matrix D·M·D, D = diag(1, 1,
 its ray, p = k×s is mirrored and reversed), so φd runs over [0, π].
 (Reciprocity would fold it to [0, π/2] but exchanges the rays, whose
 bases differ.)  Nodes below the horizon hold the matrix at polar angles
-clamped to ``HORIZON_CLAMP``, as in the M00 LUT, and G = M·cos θi·cos θs is
-stored per element, so cells straddling the horizon interpolate smoothly.
+clamped to ``HORIZON_CLAMP``, as in the M00 LUT.
+
+**What a node holds.**  G00 = M00·cos θi·cos θs, as the M00 LUT (cells
+straddling the horizon interpolate smoothly), and the *normalised* elements
+Mij/M00 (0 where M00 is 0).  A lobe's M00 changes by orders of magnitude
+across a few cells while the state of polarization it leaves in changes
+slowly, so interpolating the two apart and multiplying keeps Mij/M00 as
+accurate as the table's spacing allows; interpolating each Mij·cos θi·cos θs
+apart left errors of Mij/M00 four times larger on smooth paints.  Single
+scattering is baked with the models' own quadrature (``lut.models.rough``'s
+``SINGLE_NODES``), not the M00 LUT's coarser one: the polarization of a
+rough paint's single scattering converges more slowly than its M00 (with
+(3, 4) nodes Mij/M00 is off by up to 0.024 at θi = 66°, 0.003 with (4, 6)).
+
+**The facet term** (``closed_facet``) is also a closed form (paper Sec. 2.4,
+Eqs. 35-38: ``lut.models.facet_reflection``).  The table holds it, but its
+peak on a near-smooth rough paint is sharper than the table's cells (M00
+errors of several per cent within 2° of the mirror), so the Mitsuba plugin
+evaluates it from the closed form, and ``closed_facet=True`` does the same
+here.
 
 **Lookup** (``MuellerLUT.components``): the geometry is taken into its
-half frame, its φd folded (and D applied), the 16 elements interpolated
-trilinearly and divided by cos θi cos θs, and the matrix turned from the
+half frame, its φd folded (and D applied), G00 and the normalised elements
+interpolated trilinearly, multiplied and divided by cos θi cos θs, and the
+matrix turned from the
 half frame's transported bases into those of the models' frame (the
 source at azimuth π) by one Stokes rotation per ray.
 
@@ -44,18 +63,22 @@ import numpy as np
 
 from ..lutfiles import angles, baking, table
 from ..lutfiles import format as lutfile
-from ..models import _validate
-from ..models.rough import DIFFUSE_NODES
+from ..models import _validate, facet_reflection
+from ..models.rough import DIFFUSE_NODES, SINGLE_NODES
 from ..paint.core import COMPONENTS, Paint
 from . import basis
 
 #: Version of the Mueller LUT's file format.
-MUELLER_FORMAT = 1
-#: (N_u, N_θd, N_φd) by default: the M00 LUT's spacing, with φd over [0, π].
-DEFAULT_RESOLUTION = (64, 32, 32)
+MUELLER_FORMAT = 2
+#: (N_u, N_θd, N_φd) by default: the M00 LUT's spacing in θh and θd; φd over
+#: [0, π] at 3.8° (48 nodes), where the single scattering of a very rough paint
+#: changes its polarization fastest (at 32 nodes Mij/M00 of that component
+#: was off by up to 0.017 at slope 2.9, 0.008 at 48; more θh or θd nodes did
+#: not help).
+DEFAULT_RESOLUTION = (64, 32, 48)
 PARAMETERIZATION = (
     "rusinkiewicz in the half frame (theta_h=pi/2*u^2, theta_d, phi_d in [0, pi]); "
-    "G = M cos(theta_i) cos(theta_s) per element"
+    "G00 = M00 cos(theta_i) cos(theta_s), the other elements Mij/M00"
 )
 BASIS = "transported: s = x carried from the nearest pole along the meridian, p = k x s (Duff et al. 2017)"
 HALF_PI = np.pi / 2
@@ -64,7 +87,7 @@ MIRROR = np.diag([1.0, 1.0, -1.0, -1.0])
 
 
 def describe(
-    paint: Paint, resolution=DEFAULT_RESOLUTION, single_nodes=baking.BAKE_SINGLE_NODES, diffuse_nodes=DIFFUSE_NODES
+    paint: Paint, resolution=DEFAULT_RESOLUTION, single_nodes=SINGLE_NODES, diffuse_nodes=DIFFUSE_NODES
 ) -> dict:
     """The meta of a Mueller bake: the M00 LUT's (``lut.lutfiles.baking.describe``)
     with this table's parameterization and basis."""
@@ -102,7 +125,7 @@ def bake_mueller(
     directory,
     *,
     resolution=DEFAULT_RESOLUTION,
-    single_nodes=baking.BAKE_SINGLE_NODES,
+    single_nodes=SINGLE_NODES,
     diffuse_nodes=DIFFUSE_NODES,
     force=False,
     chunk=2048,
@@ -130,7 +153,7 @@ def _bake(paint, path, meta, chunk=2048, workers=None):
     the models' array operations) and write the file."""
     ti, ts, ps, frame = (a.ravel() for a in node_geometry(tuple(meta["resolution"])))
     opts = {
-        "single_nodes": tuple(meta.get("single_nodes", baking.BAKE_SINGLE_NODES)),
+        "single_nodes": tuple(meta.get("single_nodes", SINGLE_NODES)),
         "diffuse_nodes": tuple(meta.get("diffuse_nodes", DIFFUSE_NODES)),
     }
     tiles = meta["tiles"]
@@ -140,8 +163,11 @@ def _bake(paint, path, meta, chunk=2048, workers=None):
         sl = slice(start, start + chunk)
         m = paint.components(ti[sl], ts[sl], ps[sl], mueller=True, **opts)  # (n, T, 3, 4, 4), SCATMECH bases
         m = basis.mueller_in_transported_basis(m.reshape(m.shape[0], -1, 4, 4), ti[sl], ts[sl], ps[sl], frame[sl])
-        cos2 = np.cos(ti[sl]) * np.cos(ts[sl])
-        out[sl] = m.reshape(-1, tiles, len(COMPONENTS), 4, 4) * cos2[:, None, None, None, None]
+        m = m.reshape(-1, tiles, len(COMPONENTS), 4, 4)
+        m00 = m[..., :1, :1]
+        # Mij/M00 within [-1, 1] (a Mueller matrix's bound), 0 where M00 is 0.
+        out[sl] = np.clip(m / np.where(m00 > 0.0, m00, np.inf), -1.0, 1.0)
+        out[sl][..., 0, 0] = m00[..., 0, 0] * (np.cos(ti[sl]) * np.cos(ts[sl]))[:, None, None]
 
     workers = table.default_workers() if workers is None else max(1, int(workers))
     with concurrent.futures.ThreadPoolExecutor(max_workers=workers, thread_name_prefix="paint-mueller") as pool:
@@ -169,8 +195,8 @@ class MuellerLUT:
     Mueller matrices of the components, ``mueller(θi, θs, φs, paint)`` a
     paint's per RGB channel (both in the transported bases of the models'
     frame, ``lut.polarized.mueller_in_transported_basis``).  ``data`` is
-    (T, 16, N_φd, N_θd, N_u, 3): G = M·cos θi·cos θs per element and
-    component."""
+    (T, 16, N_φd, N_θd, N_u, 3) per element and component: G00 =
+    M00·cos θi·cos θs in element 0, Mij/M00 in the others."""
 
     def __init__(self, data, meta, path=None, key=""):
         self.data = data
@@ -186,14 +212,18 @@ class MuellerLUT:
     def internal_reflectance(self) -> float:
         return float(self.meta["internal_reflectance"])
 
-    def components(self, theta_i, theta_s, phi_s, frame=0.0) -> np.ndarray:
+    def components(self, theta_i, theta_s, phi_s, frame=0.0, closed_facet=False) -> np.ndarray:
         """The components' Mueller matrices [sr⁻¹] at model angles:
         broadcast(angles) + (T, 3, 4, 4); zero at or below the horizon.
         Referred to the transported bases of the models' frame, or of a
         frame turned from it by ``frame`` (radians, broadcast with the
         angles) about the normal, as ``basis.mueller_in_transported_basis``
         refers them: a renderer's shading frame, in which the source lies at
-        azimuth π + frame."""
+        azimuth π + frame.  ``closed_facet``: the facet component from its
+        closed form (``lut.models.facet_reflection``) instead of the table,
+        as the Mitsuba plugin evaluates it (a type with one n)."""
+        if closed_facet and self._tiles != 1:
+            raise ValueError("closed_facet needs a paint type with one n (a dispersive type has a tile per channel)")
         ti, ts, ps, frame = np.broadcast_arrays(*_validate.angles(theta_i, theta_s, phi_s), np.asarray(frame, float))
         up = (ti < HALF_PI) & (ts < HALF_PI)
         ti, ts = np.where(up, ti, 0.0), np.where(up, ts, 0.0)  # at or below the horizon: zero, whatever is looked up
@@ -207,6 +237,9 @@ class MuellerLUT:
             np.sqrt(np.clip(theta_h / HALF_PI, 0.0, 1.0)) * (n_u - 1),
         )
         g = table.trilinear(self._flat, coords).reshape(ti.shape + (self._tiles, len(COMPONENTS), 4, 4))
+        g00 = g[..., :1, :1].copy()
+        g = g * g00  # G00 times the normalised elements
+        g[..., 0, 0] = g00[..., 0, 0]
         g = np.where((phi_d < 0)[..., None, None, None, None], MIRROR @ g @ MIRROR, g)
         # From the half frame's transported bases to the wanted frame's, per ray.
         psi = []
@@ -217,14 +250,20 @@ class MuellerLUT:
         flat = g.reshape(ti.shape + (-1, 4, 4))
         g = basis.refer(flat, *psi).reshape(g.shape)
         cos2 = np.where(up, np.cos(ti) * np.cos(ts), 1.0)
-        return np.where(up[..., None, None, None, None], g / cos2[..., None, None, None, None], 0.0)
+        out = np.where(up[..., None, None, None, None], g / cos2[..., None, None, None, None], 0.0)
+        kind = self.meta["type"]
+        if closed_facet and kind["slope"] > 0.0:
+            facet = facet_reflection(ti, ts, ps, n=kind["n"], slope=kind["slope"], distribution=kind["distribution"])
+            facet = basis.mueller_in_transported_basis(facet, ti, ts, ps, frame)
+            out[..., 0, 0, :, :] = np.where(up[..., None, None], facet, 0.0)
+        return out
 
-    def mueller(self, theta_i, theta_s, phi_s, paint: Paint, frame=0.0) -> np.ndarray:
+    def mueller(self, theta_i, theta_s, phi_s, paint: Paint, frame=0.0, closed_facet=False) -> np.ndarray:
         """A paint's (of this type) Mueller matrix per RGB channel,
-        broadcast(angles) + (3, 4, 4): Σ_c a_c·M_c (``frame`` as in
-        ``components``)."""
+        broadcast(angles) + (3, 4, 4): Σ_c a_c·M_c (``frame`` and
+        ``closed_facet`` as in ``components``)."""
         amps = baking.amplitudes(self.meta, paint, "Mueller LUT")
-        comps = self.components(theta_i, theta_s, phi_s, frame)
+        comps = self.components(theta_i, theta_s, phi_s, frame, closed_facet)
         comps = np.broadcast_to(comps, comps.shape[:-4] + (3,) + comps.shape[-3:])
         return np.einsum("...hcij,hc->...hij", comps, amps)
 
@@ -247,21 +286,25 @@ def load_mueller_lut(path) -> MuellerLUT:
     return MuellerLUT(data, meta, pathlib.Path(path), attrs["paintlut:key"])
 
 
-def accuracy(table: MuellerLUT, paint: Paint, steps=17, azimuths=24) -> dict:
+def accuracy(table: MuellerLUT, paint: Paint, steps=17, azimuths=24, closed_facet=False) -> dict:
     """How near a Mueller LUT's matrices of a paint come to the models'
     (``Paint.mueller`` in the transported bases), as the M00 LUT's accuracy
     is measured (docs/lut.md): ``rms`` (4, 4), each element's cos θi-weighted
     RMS error over θi, θs in [0°, 80°] (``steps`` each) and ``azimuths``
-    azimuths, relative to M00's RMS, over RGB; ``poles``: the largest error
-    of an element other than M00 relative to M00, and ``poles_m00`` of M00,
-    at light or view along the normal (and 1e-6 rad off it) with the other
-    ray to 80° all round."""
+    azimuths, relative to M00's RMS, over RGB; ``normalised``: the largest
+    error of Mij/M00 at any of those geometries and channels (the state of
+    polarization light leaves in); ``poles``: the largest error of an
+    element other than M00 relative to M00, and ``poles_m00`` of M00, at
+    light or view along the normal (and 1e-6 rad off it) with the other ray
+    to 80° all round.  ``closed_facet`` as in ``MuellerLUT.components``."""
     t = np.radians(np.linspace(0.0, 80.0, steps))
     ti, ts, ps = (a.ravel() for a in np.meshgrid(t, t, np.linspace(-np.pi, np.pi, azimuths), indexing="ij"))
-    got = table.mueller(ti, ts, ps, paint)
+    got = table.mueller(ti, ts, ps, paint, closed_facet=closed_facet)
     ref = basis.mueller_in_transported_basis(paint.mueller(ti, ts, ps), ti, ts, ps)
     w = np.cos(ti)[:, None, None, None]
     rms = np.sqrt(np.sum(((got - ref) * w) ** 2, axis=(0, 1)) / np.sum((ref[..., :1, :1] * w) ** 2))
+    lit = ref[..., 0, 0] > 0.0
+    normalised = float(np.abs(got[lit] / got[lit][:, :1, :1] - ref[lit] / ref[lit][:, :1, :1]).max())
     x, phi = (
         a.ravel()
         for a in np.meshgrid(np.radians(np.linspace(0.0, 80.0, 9)), np.linspace(-np.pi, np.pi, 13), indexing="ij")
@@ -269,11 +312,11 @@ def accuracy(table: MuellerLUT, paint: Paint, steps=17, azimuths=24) -> dict:
     poles, poles_m00 = 0.0, 0.0
     for pole in (0.0, 1e-6):
         for a, b in ((np.full_like(x, pole), x), (x, np.full_like(x, pole))):
-            g = table.mueller(a, b, phi, paint)
+            g = table.mueller(a, b, phi, paint, closed_facet=closed_facet)
             r = basis.mueller_in_transported_basis(paint.mueller(a, b, phi), a, b, phi)
             rel = np.abs(g - r) / r[..., :1, :1]
             poles_m00 = max(poles_m00, float(rel[..., 0, 0].max()))
             rel[..., 0, 0] = 0.0
             poles = max(poles, float(rel.max()))
     polarizes = bool(np.abs(ref[..., 1:, :]).max() > 0.01 * np.abs(ref[..., 0, 0]).max())
-    return {"rms": rms, "poles": poles, "poles_m00": poles_m00, "polarizes": polarizes}
+    return {"rms": rms, "normalised": normalised, "poles": poles, "poles_m00": poles_m00, "polarizes": polarizes}
