@@ -18,12 +18,15 @@ here, when it is called.  Its properties are the paint's fields:
 **Evaluation.**  The paint's type (n, g, slope, distribution) picks a Mueller
 LUT (``lut.polarized.mueller_lut``: each colour-free component's Mueller
 matrix in the transported bases of the half frame), baked once and cached by
-content.  ``eval`` looks it up with Dr.Jit operations only (a 3-D texture of
-48 channels, then Mitsuba's ``mueller.rotate_mueller_basis`` from the half
-frame's transported bases to Mitsuba's ``mueller.stokes_basis`` of the
-incident and exit rays in the shading frame, which is the same transported
-basis built in that frame), so the JIT variants evaluate whole wavefronts
-and the scalar variant needs no numpy per sample.  The components are
+content.  ``eval`` looks single scattering and the diffuse term up with
+Dr.Jit operations only (a 3-D texture of 32 channels: G00 and Mij/M00 of
+each, then Mitsuba's ``mueller.rotate_mueller_basis`` from the half frame's
+transported bases to Mitsuba's ``mueller.stokes_basis`` of the incident and
+exit rays in the shading frame, which is the same transported basis built
+in that frame), and evaluates the facet term in closed form (paper Sec. 2.4,
+Eqs. 35-38, as ``lut.models.facet_reflection``: its peak is sharper than the
+table's cells), so the JIT variants evaluate whole wavefronts and the
+scalar variant needs no numpy per sample.  The components are
 weighted per wavelength as ``lut.Paint`` weights them per RGB channel
 (T. A. Germer, "Polarized light diffusely scattered under smooth and rough
 interfaces", Proc. SPIE 5158, 2003): the facet term by ``facet``, single
@@ -36,7 +39,7 @@ over the surface; mono variants take Mitsuba's luminance of them.
 A smooth paint (slope 0) adds the interface's mirror, a delta: Fresnel's
 reflection Mueller matrix (``mueller.specular_reflection``) times
 ``facet``, referred to the Stokes bases as Mitsuba's ``pplastic`` refers
-its own.  The LUT holds everything else, as ``lut.Paint.mueller``.
+its own.  Everything else is ``lut.Paint.mueller``'s.
 
 **Sampling.**  A mixture: cosine-weighted directions, a Beckmann lobe of
 α = slope about the normal for a rough paint (the facet term's shape; a
@@ -234,8 +237,9 @@ def _bsdf_class():
             self.rbar = table.internal_reflectance
             n_p, n_d, n_u = table.data.shape[2:5]
             self.shape = (n_u, n_d, n_p)
+            # Single scattering and the diffuse term (the facet term is a closed form, ``_facet``).
             self.texture = mi.Texture3f(
-                mi.TensorXf(np.ascontiguousarray(table._flat, dtype=np.float32)),
+                mi.TensorXf(np.ascontiguousarray(table._flat[..., 16:], dtype=np.float32)),
                 use_accel=False,
                 filter_mode=dr.FilterMode.Linear,
                 wrap_mode=dr.WrapMode.Clamp,
@@ -243,6 +247,8 @@ def _bsdf_class():
             self.smooth = self.paint.slope == 0.0
             self.facet = float(self.paint.facet)
             self.eta = float(self.paint.n)
+            self.slope = float(self.paint.slope)
+            self.gaussian = self.paint.distribution == "gaussian"
             self.alpha = min(max(float(self.paint.slope), 0.02), 2.0)
             lobe = mi.BSDFFlags.GlossyReflection if not self.smooth else mi.BSDFFlags.DiffuseReflection
             self.lobe = lobe
@@ -282,18 +288,21 @@ def _bsdf_class():
                 (dr.clip(theta_d / half_pi, 0.0, 1.0) * (n_d - 1) + 0.5) / n_d,
                 (dr.clip(dr.abs(phi_d) / math.pi, 0.0, 1.0) * (n_p - 1) + 0.5) / n_p,
             )
-            g = self.texture.eval(pos, active)  # 3 components x 16 elements of G = M cos θi cos θs
+            # Single scattering and the diffuse term: G00 = M00 cos θi cos θs and
+            # the normalised elements Mij/M00 of each (mueller_lut's layout).
+            g = self.texture.eval(pos, active)
             mirrored = phi_d < 0.0
             facet, single, k = self._amplitudes(si, active)
             inv = dr.rcp(dr.maximum(light.z * view.z, 1e-12))
+            a_single, a_diffuse = single * g[0] * inv, k * g[16] * inv
             m = mi.Spectrum(0.0)
             for e in range(16):
-                value = facet * g[e] + single * g[16 + e] + k * g[32 + e]
+                value = a_single + a_diffuse if e == 0 else a_single * g[e] + a_diffuse * g[16 + e]
                 if _MIRROR_SIGNS[e] < 0.0:
                     value = dr.select(mirrored, -value, value)
-                m[e // 4][e % 4] = value * inv
+                m[e // 4][e % 4] = value
             k_in, k_out = -light, view
-            return mi.mueller.rotate_mueller_basis(
+            m = mi.mueller.rotate_mueller_basis(
                 m,
                 k_in,
                 half_frame_basis(k_in, phi_h),
@@ -302,6 +311,36 @@ def _bsdf_class():
                 half_frame_basis(k_out, phi_h),
                 mi.mueller.stokes_basis(k_out),
             )
+            if self.smooth or self.facet == 0.0:
+                return m
+            return m + self._facet(light, view, h) * facet
+
+        def _facet(self, light, view, h):
+            """The facet term in closed form (paper Sec. 2.4, Eqs. 35-38;
+            ``lut.models.facet_reflection``): P(ζ) sec⁴θn / (4 cos θi cos θs)
+            times Fresnel's reflection matrix at the local angle ι, cos ι = ω·h,
+            referred from the facet's s/p bases (s ∝ h × ω) to Mitsuba's
+            Stokes bases.  Its peak is sharper than a table resolves, and it
+            costs a few operations."""
+            hz = dr.maximum(h.z, 1e-6)
+            zeta2 = dr.minimum((h.x * h.x + h.y * h.y) / (hz * hz), 1e8)  # tan²θn (Eq. 35)
+            s2 = self.slope * self.slope
+            if self.gaussian:
+                density = dr.exp(-zeta2 / s2) / (math.pi * s2)  # Eq. 29, Beckmann with α = s
+            else:
+                density = 3.0 / (math.pi * s2) * dr.exp(-math.sqrt(6.0) * dr.sqrt(zeta2) / self.slope)
+            scale = density * dr.square(1.0 + zeta2) / (4.0 * dr.maximum(light.z * view.z, 1e-12))
+            f = mi.mueller.specular_reflection(dr.clip(dr.dot(light, h), 0.0, 1.0), self.eta)
+            s_in, s_out = dr.cross(h, -light), dr.cross(h, view)
+            # Light returning along itself: any s across the ray is the facet's.
+            collinear = dr.squared_norm(s_in) < 1e-12
+            across = mi.mueller.stokes_basis(-light)
+            s_in = dr.select(collinear, across, dr.normalize(s_in))
+            s_out = dr.select(collinear, across, dr.normalize(s_out))
+            f = mi.mueller.rotate_mueller_basis(
+                f, -light, s_in, mi.mueller.stokes_basis(-light), view, s_out, mi.mueller.stokes_basis(view)
+            )
+            return f * scale
 
         def _mirror(self, si, light, view):
             """The smooth interface's delta: facet x Fresnel's reflection matrix,
