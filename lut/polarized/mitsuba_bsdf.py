@@ -19,7 +19,7 @@ here, when it is called.  Its properties are the paint's fields:
 LUT (``lut.polarized.mueller_lut``: each colour-free component's Mueller
 matrix in the transported bases of the half frame), baked once and cached by
 content.  ``eval`` looks single scattering and the diffuse term up with
-Dr.Jit operations only (a 3-D texture of 32 channels: G00 and Mij/M00 of
+Dr.Jit operations only (a 3-D texture of 32 channels: M00 and Mij/M00 of
 each, then Mitsuba's ``mueller.rotate_mueller_basis`` from the half frame's
 transported bases to Mitsuba's ``mueller.stokes_basis`` of the incident and
 exit rays in the shading frame, which is the same transported basis built
@@ -235,6 +235,7 @@ def _bsdf_class():
             table = mueller_lut.load_mueller_lut(path)
             self.lut_path = str(path)
             self.rbar = table.internal_reflectance
+            self.cos_power = int(table.meta["cos_power"][1])
             n_p, n_d, n_u = table.data.shape[2:5]
             self.shape = (n_u, n_d, n_p)
             # Single scattering and the diffuse term (the facet term is a closed form, ``_facet``).
@@ -288,13 +289,14 @@ def _bsdf_class():
                 (dr.clip(theta_d / half_pi, 0.0, 1.0) * (n_d - 1) + 0.5) / n_d,
                 (dr.clip(dr.abs(phi_d) / math.pi, 0.0, 1.0) * (n_p - 1) + 0.5) / n_p,
             )
-            # Single scattering and the diffuse term: G00 = M00 cos θi cos θs and
-            # the normalised elements Mij/M00 of each (mueller_lut's layout).
+            # Single scattering and the diffuse term: M00 and the normalised
+            # elements Mij/M00 of each (mueller_lut's layout).
             g = self.texture.eval(pos, active)
             mirrored = phi_d < 0.0
             facet, single, k = self._amplitudes(si, active)
-            inv = dr.rcp(dr.maximum(light.z * view.z, 1e-12))
-            a_single, a_diffuse = single * g[0] * inv, k * g[16] * inv
+            a_single, a_diffuse = single * g[0], k * g[16]
+            if self.cos_power == -1:  # stored M00 / (cos θi cos θs) (mueller_lut.cos_power)
+                a_single, a_diffuse = a_single * (light.z * view.z), a_diffuse * (light.z * view.z)
             m = mi.Spectrum(0.0)
             for e in range(16):
                 value = a_single + a_diffuse if e == 0 else a_single * g[e] + a_diffuse * g[16 + e]

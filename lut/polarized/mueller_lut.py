@@ -16,20 +16,32 @@ through the normal and the half vector has the matrix D·M·D, D = diag(1, 1,
 -1, -1) (U and V change sign: the transported basis's s is mirrored with
 its ray, p = k×s is mirrored and reversed), so φd runs over [0, π].
 (Reciprocity would fold it to [0, π/2] but exchanges the rays, whose
-bases differ.)  Nodes below the horizon hold the matrix at polar angles
-clamped to ``HORIZON_CLAMP``, as in the M00 LUT.
+bases differ.)
 
-**What a node holds.**  G00 = M00·cos θi·cos θs, as the M00 LUT (cells
-straddling the horizon interpolate smoothly), and the *normalised* elements
-Mij/M00 (0 where M00 is 0).  A lobe's M00 changes by orders of magnitude
-across a few cells while the state of polarization it leaves in changes
-slowly, so interpolating the two apart and multiplying keeps Mij/M00 as
-accurate as the table's spacing allows; interpolating each Mij·cos θi·cos θs
-apart left errors of Mij/M00 four times larger on smooth paints.  Single
-scattering is baked with the models' own quadrature (``lut.models.rough``'s
-``SINGLE_NODES``), not the M00 LUT's coarser one: the polarization of a
-rough paint's single scattering converges more slowly than its M00 (with
-(3, 4) nodes Mij/M00 is off by up to 0.024 at θi = 66°, 0.003 with (4, 6)).
+**What a node holds.**  M00 times (cos θi·cos θs)^p, with p per component
+(``cos_power``) such that the product stays smooth up to the horizon: p = 1
+for the facet term, whose M00 grows like 1/(cos θi cos θs) there (the M00
+LUT's G); p = -1 for single scattering and the diffuse term under a smooth
+interface, which fade like the Fresnel transmittances (like cos θ); p = 0
+under a rough one, where they stay finite.  The other elements are stored
+*normalised*, Mij/M00 (within [-1, 1], 0 where M00 is 0).  A lobe's M00
+changes by orders of magnitude across a few cells while the state of
+polarization it leaves light in changes slowly, so the two are interpolated
+apart and multiplied: interpolating each Mij·cos θi·cos θs apart left errors
+of Mij/M00 four times larger on smooth paints.
+
+**Below the horizon** a node holds the values continued past it by their
+point reflection there (``horizon_terms``: f(θ) = 2 f(π/2) - f(π - θ), ray by
+ray), which keeps a cell straddling the horizon accurate to second order.
+Holding the matrix at 89° instead (the M00 LUT's clamp) left M00 off by up
+to 2.5 times with a ray beyond 85° (27% RMS on smooth paints), Mij/M00 by
+up to 0.12.
+
+**Quadrature.**  Single scattering is baked with the models' own
+(``lut.models.rough``'s ``SINGLE_NODES``), not the M00 LUT's coarser one:
+the polarization of a rough paint's single scattering converges more slowly
+than its M00 (with (3, 4) nodes Mij/M00 is off by up to 0.024 at θi = 66°,
+0.003 with (4, 6), against (12, 18)).
 
 **The facet term** (``closed_facet``) is also a closed form (paper Sec. 2.4,
 Eqs. 35-38: ``lut.models.facet_reflection``).  The table holds it, but its
@@ -39,11 +51,11 @@ evaluates it from the closed form, and ``closed_facet=True`` does the same
 here.
 
 **Lookup** (``MuellerLUT.components``): the geometry is taken into its
-half frame, its φd folded (and D applied), G00 and the normalised elements
-interpolated trilinearly, multiplied and divided by cos θi cos θs, and the
-matrix turned from the
-half frame's transported bases into those of the models' frame (the
-source at azimuth π) by one Stokes rotation per ray.
+half frame, its φd folded (and D applied), every stored value interpolated
+trilinearly, M00 freed of its cos power and the normalised elements
+multiplied by it, and the matrix turned from the half frame's transported
+bases into those of the models' frame (the source at azimuth π) by one
+Stokes rotation per ray.
 
 **Image layout.** float32, three channels (the components), width N_u,
 height T·16·N_φd·N_θd: tile t (1, or 3 for a dispersive paint), element
@@ -78,10 +90,13 @@ MUELLER_FORMAT = 2
 DEFAULT_RESOLUTION = (64, 32, 48)
 PARAMETERIZATION = (
     "rusinkiewicz in the half frame (theta_h=pi/2*u^2, theta_d, phi_d in [0, pi]); "
-    "G00 = M00 cos(theta_i) cos(theta_s), the other elements Mij/M00"
+    "M00 (cos(theta_i) cos(theta_s))^cos_power, the other elements Mij/M00; "
+    "below the horizon the point reflection of each ray's values"
 )
 BASIS = "transported: s = x carried from the nearest pole along the meridian, p = k x s (Duff et al. 2017)"
 HALF_PI = np.pi / 2
+#: The polar angle that stands for the horizon in ``horizon_terms``.
+HORIZON_EDGE = HALF_PI - 1e-5
 #: D of the mirror fold: U and V change sign.
 MIRROR = np.diag([1.0, 1.0, -1.0, -1.0])
 
@@ -92,7 +107,23 @@ def describe(
     """The meta of a Mueller bake: the M00 LUT's (``lut.lutfiles.baking.describe``)
     with this table's parameterization and basis."""
     meta = baking.describe(paint, resolution, single_nodes, diffuse_nodes)
-    return {**meta, "format": MUELLER_FORMAT, "parameterization": PARAMETERIZATION, "basis": BASIS}
+    return {
+        **meta,
+        "format": MUELLER_FORMAT,
+        "parameterization": PARAMETERIZATION,
+        "basis": BASIS,
+        "cos_power": list(cos_power(paint.slope)),
+    }
+
+
+def cos_power(slope) -> tuple:
+    """Per component (facet, single, diffuse), the power p of cos θi·cos θs
+    that multiplies M00 in the table (module docstring): the facet's M00 grows
+    like 1/(cos θi cos θs) towards the horizon (p = 1); under a smooth
+    interface single scattering and the diffuse term fade like the Fresnel
+    transmittances, like cos θ (p = -1); under a rough one they stay finite
+    (p = 0)."""
+    return (1, -1, -1) if slope == 0.0 else (1, 0, 0)
 
 
 def mueller_lut_path(paint: Paint, directory, **options) -> pathlib.Path:
@@ -106,18 +137,53 @@ def _axes(resolution):
     return HALF_PI * u * u, np.linspace(0.0, HALF_PI, n_d), np.linspace(0.0, np.pi, n_p)
 
 
-def node_geometry(resolution):
+def node_geometry(resolution, clamp=True):
     """Per node (N_φd, N_θd, N_u): model angles (θi, θs, φs), polar angles
-    clamped to ``table.HORIZON_CLAMP``, and the half frame's turn from the
-    models' frame (the light's azimuth there minus π)."""
+    clamped to ``table.HORIZON_CLAMP`` (beyond π/2 below the horizon with
+    ``clamp=False``), and the half frame's turn from the models' frame (the
+    light's azimuth there minus π)."""
     th, td, pd = _axes(resolution)
     wi, wo = angles.half_frame_rays(th[None, None, :], td[None, :, None], pd[:, None, None])
     light = np.arctan2(wi[..., 1], wi[..., 0])
     view = np.arctan2(wo[..., 1], wo[..., 0])
-    ti = np.minimum(np.arccos(np.clip(wi[..., 2], -1.0, 1.0)), table.HORIZON_CLAMP)
-    ts = np.minimum(np.arccos(np.clip(wo[..., 2], -1.0, 1.0)), table.HORIZON_CLAMP)
+    ti = np.arccos(np.clip(wi[..., 2], -1.0, 1.0))
+    ts = np.arccos(np.clip(wo[..., 2], -1.0, 1.0))
+    if clamp:
+        ti, ts = np.minimum(ti, table.HORIZON_CLAMP), np.minimum(ts, table.HORIZON_CLAMP)
     ps = np.mod(view - light + 2 * np.pi, 2 * np.pi) - np.pi
     return ti, ts, ps, light - np.pi
+
+
+def horizon_terms(theta_i, theta_s):
+    """What nodes below the horizon hold: each stored value f continued past
+    the horizon by its point reflection there, ray by ray,
+
+        f(θ) = 2 f(π/2) - f(π - θ)    (θ > π/2),
+
+    which has f's value and slope at the horizon, so a cell straddling it
+    interpolates to second order whatever f does there (fades like cos θ
+    under a smooth interface, stays finite under a rough one).  A node with
+    both rays below takes the product of the two reflections.  Returns
+    (node, weight, θi, θs) of the terms whose weighted sum is each node's
+    value (f(π/2) taken at ``HORIZON_EDGE``, where the models still
+    scatter)."""
+    ti, ts = np.asarray(theta_i, float).ravel(), np.asarray(theta_s, float).ravel()
+    nodes = np.arange(ti.size)
+
+    def leg(t, reflected):
+        below = t >= HORIZON_EDGE
+        if reflected:
+            return below, np.full_like(t, -1.0), np.minimum(np.pi - t, HORIZON_EDGE)
+        return np.ones_like(below), np.where(below, 2.0, 1.0), np.where(below, HORIZON_EDGE, t)
+
+    parts = []
+    for ri in (False, True):
+        for rs in (False, True):
+            keep_i, w_i, a_i = leg(ti, ri)
+            keep_s, w_s, a_s = leg(ts, rs)
+            keep = keep_i & keep_s
+            parts.append((nodes[keep], (w_i * w_s)[keep], a_i[keep], a_s[keep]))
+    return tuple(np.concatenate(column) for column in zip(*parts, strict=True))
 
 
 def bake_mueller(
@@ -148,31 +214,37 @@ def bake_mueller(
 
 
 def _bake(paint, path, meta, chunk=2048, workers=None):
-    """Tabulate G of every node in chunks on ``workers`` threads (default
+    """Tabulate every node's values (module docstring; below the horizon
+    ``horizon_terms``) in chunks on ``workers`` threads (default
     ``table.default_workers``: numpy releases the interpreter lock inside
     the models' array operations) and write the file."""
-    ti, ts, ps, frame = (a.ravel() for a in node_geometry(tuple(meta["resolution"])))
+    ti, ts, ps, frame = (a.ravel() for a in node_geometry(tuple(meta["resolution"]), clamp=False))
+    node, weight, t_i, t_s = horizon_terms(ti, ts)
+    p_s, turn = ps[node], frame[node]
     opts = {
         "single_nodes": tuple(meta.get("single_nodes", SINGLE_NODES)),
         "diffuse_nodes": tuple(meta.get("diffuse_nodes", DIFFUSE_NODES)),
     }
     tiles = meta["tiles"]
-    out = np.empty((ti.size, tiles, len(COMPONENTS), 4, 4))
+    power = np.array(meta["cos_power"], dtype=float)
+    values = np.empty((node.size, tiles, len(COMPONENTS), 4, 4))
 
     def run(start):
         sl = slice(start, start + chunk)
-        m = paint.components(ti[sl], ts[sl], ps[sl], mueller=True, **opts)  # (n, T, 3, 4, 4), SCATMECH bases
-        m = basis.mueller_in_transported_basis(m.reshape(m.shape[0], -1, 4, 4), ti[sl], ts[sl], ps[sl], frame[sl])
+        m = paint.components(t_i[sl], t_s[sl], p_s[sl], mueller=True, **opts)  # (n, T, 3, 4, 4), SCATMECH bases
+        m = basis.mueller_in_transported_basis(m.reshape(m.shape[0], -1, 4, 4), t_i[sl], t_s[sl], p_s[sl], turn[sl])
         m = m.reshape(-1, tiles, len(COMPONENTS), 4, 4)
         m00 = m[..., :1, :1]
         # Mij/M00 within [-1, 1] (a Mueller matrix's bound), 0 where M00 is 0.
-        out[sl] = np.clip(m / np.where(m00 > 0.0, m00, np.inf), -1.0, 1.0)
-        out[sl][..., 0, 0] = m00[..., 0, 0] * (np.cos(ti[sl]) * np.cos(ts[sl]))[:, None, None]
+        values[sl] = np.clip(m / np.where(m00 > 0.0, m00, np.inf), -1.0, 1.0)
+        values[sl][..., 0, 0] = m00[..., 0, 0] * (np.cos(t_i[sl]) * np.cos(t_s[sl]))[:, None, None] ** power
 
     workers = table.default_workers() if workers is None else max(1, int(workers))
     with concurrent.futures.ThreadPoolExecutor(max_workers=workers, thread_name_prefix="paint-mueller") as pool:
-        for future in [pool.submit(run, start) for start in range(0, ti.size, chunk)]:
+        for future in [pool.submit(run, start) for start in range(0, node.size, chunk)]:
             future.result()
+    out = np.zeros((ti.size, tiles, len(COMPONENTS), 4, 4))
+    np.add.at(out, node, weight[:, None, None, None, None] * values)
     n_u, n_d, n_p = meta["resolution"]
     grid = out.reshape(n_p, n_d, n_u, tiles, len(COMPONENTS), 16)
     image = np.ascontiguousarray(np.transpose(grid, (3, 5, 0, 1, 2, 4)).reshape(-1, n_u, len(COMPONENTS)), np.float32)
@@ -195,8 +267,9 @@ class MuellerLUT:
     Mueller matrices of the components, ``mueller(θi, θs, φs, paint)`` a
     paint's per RGB channel (both in the transported bases of the models'
     frame, ``lut.polarized.mueller_in_transported_basis``).  ``data`` is
-    (T, 16, N_φd, N_θd, N_u, 3) per element and component: G00 =
-    M00·cos θi·cos θs in element 0, Mij/M00 in the others."""
+    (T, 16, N_φd, N_θd, N_u, 3) per element and component: M00·(cos θi
+    cos θs)^p in element 0 (p = ``meta["cos_power"]`` per component),
+    Mij/M00 in the others."""
 
     def __init__(self, data, meta, path=None, key=""):
         self.data = data
@@ -238,7 +311,7 @@ class MuellerLUT:
         )
         g = table.trilinear(self._flat, coords).reshape(ti.shape + (self._tiles, len(COMPONENTS), 4, 4))
         g00 = g[..., :1, :1].copy()
-        g = g * g00  # G00 times the normalised elements
+        g = g * g00  # M00 (times its cos power) times the normalised elements
         g[..., 0, 0] = g00[..., 0, 0]
         g = np.where((phi_d < 0)[..., None, None, None, None], MIRROR @ g @ MIRROR, g)
         # From the half frame's transported bases to the wanted frame's, per ray.
@@ -249,8 +322,10 @@ class MuellerLUT:
             psi.append(basis.turn(k, s_half, np.cross(k, s_half), s_to))
         flat = g.reshape(ti.shape + (-1, 4, 4))
         g = basis.refer(flat, *psi).reshape(g.shape)
+        # M00 was stored times (cos θi cos θs)^p, p per component (``cos_power``).
         cos2 = np.where(up, np.cos(ti) * np.cos(ts), 1.0)
-        out = np.where(up[..., None, None, None, None], g / cos2[..., None, None, None, None], 0.0)
+        scale = cos2[..., None, None] ** -np.asarray(self.meta["cos_power"], dtype=float)
+        out = np.where(up[..., None, None, None, None], g * scale[..., None, None], 0.0)
         kind = self.meta["type"]
         if closed_facet and kind["slope"] > 0.0:
             facet = facet_reflection(ti, ts, ps, n=kind["n"], slope=kind["slope"], distribution=kind["distribution"])
