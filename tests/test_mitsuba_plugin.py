@@ -153,10 +153,10 @@ GEOMETRIES = [(0.5, 0.3, 0.7, 2.0), (1.2, -1.0, 0.3, 0.5), (0.2, 0.0, 1.1, 3.0),
 def test_rendered_stokes_vectors_match_the_model(index, cache):
     """S0..S3 rendered vs the model's within 1% of the unpolarized S0, for
     unpolarized light and through a polarizer at three angles (measured
-    worst 0.87% and 0.49%, docs/polarized.md).  The renderer's white (its own Lambertian under the
-    same emitter and sensor, whose RGB of a flat spectrum is not exactly 1)
-    is divided out; the stratified sampler gives both renders the same
-    wavelengths."""
+    worst 0.61% and 0.35%, docs/polarized.md).  The renderer's white (its
+    own Lambertian under the same emitter and sensor, whose RGB of a flat
+    spectrum is not exactly 1) is divided out; the stratified sampler gives
+    both renders the same wavelengths."""
     _, paint = PAINTS[index]
     bsdf = plugin(paint, cache)
     white = {"type": "diffuse", "reflectance": {"type": "rgb", "value": 1.0}}

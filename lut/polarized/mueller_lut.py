@@ -43,12 +43,13 @@ the polarization of a rough paint's single scattering converges more slowly
 than its M00 (with (3, 4) nodes Mij/M00 is off by up to 0.024 at θi = 66°,
 0.003 with (4, 6), against (12, 18)).
 
-**The facet term** (``closed_facet``) is also a closed form (paper Sec. 2.4,
+**The facet term** (``closed_facet``) is a closed form (paper Sec. 2.4,
 Eqs. 35-38: ``lut.models.facet_reflection``).  The table holds it, but its
 peak on a near-smooth rough paint is sharper than the table's cells (M00
-errors of several per cent within 2° of the mirror), so the Mitsuba plugin
-evaluates it from the closed form, and ``closed_facet=True`` does the same
-here.
+errors of several per cent near the mirror), so the Mitsuba plugin
+evaluates it from the closed form, and so does the lookup here by default
+for a type with one n; a dispersive type's (one tile per channel) comes
+from the table.
 
 **Lookup** (``MuellerLUT.components``): the geometry is taken into its
 half frame, its φd folded (and D applied), every stored value interpolated
@@ -285,7 +286,7 @@ class MuellerLUT:
     def internal_reflectance(self) -> float:
         return float(self.meta["internal_reflectance"])
 
-    def components(self, theta_i, theta_s, phi_s, frame=0.0, closed_facet=False) -> np.ndarray:
+    def components(self, theta_i, theta_s, phi_s, frame=0.0, closed_facet=None) -> np.ndarray:
         """The components' Mueller matrices [sr⁻¹] at model angles:
         broadcast(angles) + (T, 3, 4, 4); zero at or below the horizon.
         Referred to the transported bases of the models' frame, or of a
@@ -293,8 +294,11 @@ class MuellerLUT:
         angles) about the normal, as ``basis.mueller_in_transported_basis``
         refers them: a renderer's shading frame, in which the source lies at
         azimuth π + frame.  ``closed_facet``: the facet component from its
-        closed form (``lut.models.facet_reflection``) instead of the table,
-        as the Mitsuba plugin evaluates it (a type with one n)."""
+        closed form (``lut.models.facet_reflection``), as the Mitsuba plugin
+        evaluates it, rather than from the table; by default wherever the
+        type has one n (a dispersive type's facet comes from the table)."""
+        if closed_facet is None:
+            closed_facet = self._tiles == 1
         if closed_facet and self._tiles != 1:
             raise ValueError("closed_facet needs a paint type with one n (a dispersive type has a tile per channel)")
         ti, ts, ps, frame = np.broadcast_arrays(*_validate.angles(theta_i, theta_s, phi_s), np.asarray(frame, float))
@@ -333,7 +337,7 @@ class MuellerLUT:
             out[..., 0, 0, :, :] = np.where(up[..., None, None], facet, 0.0)
         return out
 
-    def mueller(self, theta_i, theta_s, phi_s, paint: Paint, frame=0.0, closed_facet=False) -> np.ndarray:
+    def mueller(self, theta_i, theta_s, phi_s, paint: Paint, frame=0.0, closed_facet=None) -> np.ndarray:
         """A paint's (of this type) Mueller matrix per RGB channel,
         broadcast(angles) + (3, 4, 4): Σ_c a_c·M_c (``frame`` and
         ``closed_facet`` as in ``components``)."""
@@ -361,7 +365,7 @@ def load_mueller_lut(path) -> MuellerLUT:
     return MuellerLUT(data, meta, pathlib.Path(path), attrs["paintlut:key"])
 
 
-def accuracy(table: MuellerLUT, paint: Paint, steps=17, azimuths=24, closed_facet=False) -> dict:
+def accuracy(table: MuellerLUT, paint: Paint, steps=17, azimuths=24, closed_facet=None) -> dict:
     """How near a Mueller LUT's matrices of a paint come to the models'
     (``Paint.mueller`` in the transported bases), as the M00 LUT's accuracy
     is measured (docs/lut.md): ``rms`` (4, 4), each element's cos θi-weighted
