@@ -6,9 +6,9 @@ on the randomised set (``lut.bench.random_paints``, fixed seed).
 Prints per paint, from ``mueller_lut.accuracy``: M00's and the worst other
 element's cos θi-weighted RMS error relative to M00 (θi, θs <= 80°, all
 azimuths), the largest error of Mij/M00 there, the worst pointwise error at
-the poles (M00, and any other element relative to M00); the first three
-again with the facet term in closed form (``closed_facet``, as the Mitsuba
-plugin evaluates it); the bake time (a cache hit is baked again) and the
+the poles (M00, and any other element relative to M00); all five for the
+table's own facet term and for the facet term in closed form (the lookup's
+default for a type with one n, and the Mitsuba plugin's); the bake time (a cache hit is baked again) and the
 file's size; then the worst and the median of each column."""
 
 from __future__ import annotations
@@ -35,8 +35,8 @@ def main(argv=None):
     with tempfile.TemporaryDirectory() as tmp:
         directory = args.directory or pathlib.Path(tmp)
         rows = []
-        columns = ("M00 rms", "other", "Mij/M00", "pole M00", "pole oth", "M00 rms", "other", "Mij/M00")
-        print(f"{'':28s} {'the table':^44s}  {'facet in closed form':^26s}")
+        columns = ("M00 rms", "other", "Mij/M00", "pole M00", "pole oth") * 2
+        print(f"{'':28s} {'the table':^44s}  {'facet in closed form (the default)':^44s}")
         print(f"{'paint':28s} " + " ".join(f"{c:>8s}" for c in columns) + f" {'bake s':>7s} {'MB':>5s}")
         for label, paint in bench.random_paints(args.count):
             start = time.perf_counter()
@@ -49,9 +49,7 @@ def main(argv=None):
                 rms = found["rms"].copy()
                 m00 = rms[0, 0]
                 rms[0, 0] = 0.0
-                row += [100 * m00, 100 * rms.max(), found["normalised"]]
-                if not closed:
-                    row += [100 * found["poles_m00"], 100 * found["poles"]]
+                row += [100 * m00, 100 * rms.max(), found["normalised"], 100 * found["poles_m00"], 100 * found["poles"]]
             rows.append(row + [seconds, path.stat().st_size / 1e6])
             print(f"{label:28s} " + _cells(rows[-1]))
         rows = np.array(rows)
@@ -61,8 +59,8 @@ def main(argv=None):
 
 def _cells(row) -> str:
     """A row of the table: per cent, the Mij/M00 errors as they are, seconds, MB."""
-    cells = [f"{v:7.2f}%" if k not in (2, 7) else f"{v:8.4f}" for k, v in enumerate(row[:8])]
-    return " ".join(cells) + f" {row[8]:7.1f} {row[9]:5.1f}"
+    cells = [f"{v:7.2f}%" if k % 5 != 2 else f"{v:8.4f}" for k, v in enumerate(row[:10])]
+    return " ".join(cells) + f" {row[10]:7.1f} {row[11]:5.1f}"
 
 
 if __name__ == "__main__":
