@@ -8,8 +8,9 @@ element's cos θi-weighted RMS error relative to M00 (θi, θs <= 80°, all
 azimuths), the largest error of Mij/M00 there, the worst pointwise error at
 the poles (M00, and any other element relative to M00); all five for the
 table's own facet term and for the facet term in closed form (the lookup's
-default for a type with one n, and the Mitsuba plugin's); the bake time (a cache hit is baked again) and the
-file's size; then the worst and the median of each column."""
+default for a type with one n, and the Mitsuba plugin's); the bake time (a
+cache hit is baked again) and the file's size; then the worst and the
+median of each column."""
 
 from __future__ import annotations
 

@@ -204,6 +204,23 @@ def _bsdf_class():
         b = mi.mueller.stokes_basis(local)
         return mi.Vector3f(c * b.x - s * b.y, s * b.x + c * b.y, b.z)
 
+    def fresnel_reflection(light, view, normal, eta):
+        """Fresnel's reflection Mueller matrix of a dielectric surface of unit
+        ``normal`` (a mirror's, or a facet's), at cos ι = |ω·normal|, referred
+        from its s/p bases (s ∝ normal × ray, as Mitsuba's ``conductor`` and
+        ``pplastic`` refer theirs) to Mitsuba's Stokes bases.  Light that
+        returns along itself, or meets the mirror along its normal, has no
+        plane of incidence: any s across the ray is the surface's."""
+        f = mi.mueller.specular_reflection(dr.clip(dr.abs(dr.dot(light, normal)), 0.0, 1.0), eta)
+        s_in, s_out = dr.cross(normal, -light), dr.cross(normal, view)
+        collinear = dr.squared_norm(s_in) < 1e-12
+        across = mi.mueller.stokes_basis(-light)
+        s_in = dr.select(collinear, across, dr.normalize(s_in))
+        s_out = dr.select(collinear, across, dr.normalize(s_out))
+        return mi.mueller.rotate_mueller_basis(
+            f, -light, s_in, mi.mueller.stokes_basis(-light), view, s_out, mi.mueller.stokes_basis(view)
+        )
+
     def colour_texture(props, name):
         """A colour property as a texture, its values within [0, 1] (a float
         is checked exactly, a texture by its largest value)."""
@@ -319,11 +336,11 @@ def _bsdf_class():
 
         def _facet(self, light, view, h):
             """The facet term in closed form (paper Sec. 2.4, Eqs. 35-38;
-            ``lut.models.facet_reflection``): P(ζ) sec⁴θn / (4 cos θi cos θs)
-            times Fresnel's reflection matrix at the local angle ι, cos ι = ω·h,
-            referred from the facet's s/p bases (s ∝ h × ω) to Mitsuba's
-            Stokes bases.  Its peak is sharper than a table resolves, and it
-            costs a few operations."""
+            ``lut.models.facet_reflection``, P(ζ) as
+            ``lut.models.distributions.pdf``): P(ζ) sec⁴θn / (4 cos θi cos θs)
+            times Fresnel's reflection matrix of the facet (normal h).  Its
+            peak is sharper than a table resolves, and it costs a few
+            operations."""
             hz = dr.maximum(h.z, 1e-6)
             zeta2 = dr.minimum((h.x * h.x + h.y * h.y) / (hz * hz), 1e8)  # tan²θn (Eq. 35)
             s2 = self.slope * self.slope
@@ -332,30 +349,12 @@ def _bsdf_class():
             else:
                 density = 3.0 / (math.pi * s2) * dr.exp(-math.sqrt(6.0) * dr.sqrt(zeta2) / self.slope)
             scale = density * dr.square(1.0 + zeta2) / (4.0 * dr.maximum(light.z * view.z, 1e-12))
-            f = mi.mueller.specular_reflection(dr.clip(dr.dot(light, h), 0.0, 1.0), self.eta)
-            s_in, s_out = dr.cross(h, -light), dr.cross(h, view)
-            # Light returning along itself: any s across the ray is the facet's.
-            collinear = dr.squared_norm(s_in) < 1e-12
-            across = mi.mueller.stokes_basis(-light)
-            s_in = dr.select(collinear, across, dr.normalize(s_in))
-            s_out = dr.select(collinear, across, dr.normalize(s_out))
-            f = mi.mueller.rotate_mueller_basis(
-                f, -light, s_in, mi.mueller.stokes_basis(-light), view, s_out, mi.mueller.stokes_basis(view)
-            )
-            return f * scale
+            return fresnel_reflection(light, view, h, self.eta) * scale
 
         def _mirror(self, si, light, view):
             """The smooth interface's delta: facet x Fresnel's reflection matrix,
             in Mitsuba's Stokes bases (as ``pplastic`` refers its own)."""
-            n = mi.Vector3f(0.0, 0.0, 1.0)
-            f = mi.mueller.specular_reflection(dr.abs(light.z), self.eta) * self.facet
-            s_in, s_out = dr.cross(n, -light), dr.cross(n, view)
-            collinear = dr.squared_norm(s_in) < 1e-20
-            s_in = dr.select(collinear, mi.Vector3f(1.0, 0.0, 0.0), dr.normalize(s_in))
-            s_out = dr.select(collinear, mi.Vector3f(1.0, 0.0, 0.0), dr.normalize(s_out))
-            return mi.mueller.rotate_mueller_basis(
-                f, -light, s_in, mi.mueller.stokes_basis(-light), view, s_out, mi.mueller.stokes_basis(view)
-            )
+            return fresnel_reflection(light, view, mi.Vector3f(0.0, 0.0, 1.0), self.eta) * self.facet
 
         def _rays(self, ctx, si, wo):
             """(towards the light, towards the viewer) of a query."""
