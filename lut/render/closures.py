@@ -44,6 +44,16 @@ irradiance, cos θl included (what Cycles' eval returns), for a white closure:
   height-correlated Smith G of GGX (Walter et al. 2007, Eqs. 33-34).  Grey.
   Blender 4.2-4.5 have no exact dielectric Metallic, so these are their
   facet lobes.
+* ``diffuse_ramp``: one knot j of OSL's ``diffuse_ramp(N, colors[8])``
+  (Cycles' bsdf_diffuse_ramp.h, OSL only: CPU and OptiX): the ramp over
+  cos θl, linear between 8 knots at cos θl = j/7, divided by π and with no
+  further cos θl, so a knot's closure is hat_j(cos θl)/π with
+  hat_j(x) = max(0, 1 - |7x - j|).  Its weight is **signed**: OSL passes the
+  ramp colours unclamped, and a correction of the other closures may be
+  negative (``lut.render.fitting``, "OSL ramps").
+* ``phong_ramp``:   one knot j of OSL's ``phong_ramp(N, e, colors[8])``
+  (Cycles' bsdf_phong_ramp.h): with p = (R·l)^e, R the mirror of the view,
+  hat_j(p)·p·(e + 2)/(2π)·cos θl where R·l > 0, else 0.  Signed.
 
 Angles follow ``lut.models``: the light at polar angle θl and azimuth π, the
 viewer at (θv, φ), φ = 0 the mirror direction."""
@@ -61,13 +71,16 @@ from ..paint.core import reference_index
 @dataclasses.dataclass(frozen=True)
 class Closure:
     """One basis closure: its kind (a key of ``CLOSURE_KINDS``), the Toon
-    size and smooth, the lobes' IOR and roughness."""
+    size and smooth, the lobes' IOR and roughness, and for an OSL ramp's
+    knot its index (0 to ``RAMP_KNOTS`` - 1) and the Phong ramp's exponent."""
 
     kind: str
     size: float = 0.0
     smooth: float = 0.0
     ior: float = 1.5
     roughness: float = 0.5
+    knot: int = 0
+    exponent: float = 1.0
 
     def __post_init__(self):
         validate_kind(self.kind)
@@ -89,13 +102,23 @@ class Closure:
         closures of unit colour)."""
         return 1.0 if self.grey or self.kind == "oren_nayar" else np.inf
 
+    @property
+    def osl(self) -> bool:
+        """Whether only Cycles' OSL shading draws it (a ramp knot: the ramps' Script node)."""
+        return CLOSURE_KINDS[self.kind].osl
+
     def evaluate(self, theta_l, theta_v, phi):
         """Contribution per unit irradiance (cos θl included), broadcast shape."""
         theta_l, theta_v, phi = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (theta_l, theta_v, phi)))
         return CLOSURE_KINDS[self.kind].evaluate(self, theta_l, theta_v, phi)
 
     def to_dict(self) -> dict:
-        return dataclasses.asdict(self)
+        """Its fields; a ramp's knot and exponent only for the ramps (the
+        other kinds' headers stay as they were)."""
+        out = dataclasses.asdict(self)
+        if not self.osl:
+            del out["knot"], out["exponent"]
+        return out
 
 
 def _toon(angle, size, smooth):
@@ -283,6 +306,44 @@ def _oren_nayar(closure, theta_l, theta_v, phi):
     return np.where(up, cl * (a + b * t + e_ms * (1.0 - e_v) * (1.0 - e_l)), 0.0)
 
 
+#: Knots of an OSL ramp closure (``diffuse_ramp``, ``phong_ramp``: colors[8]).
+RAMP_KNOTS = 8
+
+
+def ramp_hat(position, knot):
+    """The share of knot ``knot`` in a ramp's value at ``position`` in [0, 1]:
+    Cycles' bsdf_*_ramp_get_color interpolates linearly between 8 knots
+    evenly spaced on [0, 1], hat_j(x) = max(0, 1 - |7x - j|)."""
+    x = np.clip(np.asarray(position, dtype=float), 0.0, 1.0) * (RAMP_KNOTS - 1)
+    return np.maximum(0.0, 1.0 - np.abs(x - knot))
+
+
+def _diffuse_ramp(closure, theta_l, theta_v, phi):
+    """One knot of OSL's diffuse_ramp: hat_j(cos θl)/π (no further cos θl:
+    the ramp is the whole light dependence), lights above the surface."""
+    up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2)
+    return np.where(up, ramp_hat(np.cos(theta_l), closure.knot) / np.pi, 0.0)
+
+
+def _phong_ramp(closure, theta_l, theta_v, phi):
+    """One knot of OSL's phong_ramp of exponent e: p = (R·l)^e with R the
+    mirror of the view, hat_j(p)·p·(e + 2)/(2π)·cos θl where R·l > 0."""
+    cos_rl = np.sin(theta_v) * np.cos(phi) * np.sin(theta_l) + np.cos(theta_v) * np.cos(theta_l)
+    e = max(float(closure.exponent), 0.0)
+    p = np.maximum(cos_rl, 0.0) ** e
+    value = ramp_hat(p, closure.knot) * p * (e + 2.0) / (2.0 * np.pi) * np.cos(theta_l)
+    up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2) & (cos_rl > 0)
+    return np.where(up, value, 0.0)
+
+
+def ramp_closures(exponents=(1.0,)) -> list:
+    """The knots of one diffuse ramp and of a Phong ramp per exponent: the
+    signed corrections an OSL fit adds (``lut.render.fitting``)."""
+    knots = [Closure("diffuse_ramp", knot=j) for j in range(RAMP_KNOTS)]
+    knots += [Closure("phong_ramp", knot=j, exponent=float(e)) for e in exponents for j in range(RAMP_KNOTS)]
+    return knots
+
+
 # ---------------------------------------------------------------------- EEVEE's rendering
 
 #: The roughnesses (glossy, metallic) and Metallic BSDF IORs at which EEVEE's
@@ -345,15 +406,17 @@ class ClosureKind:
     """A registered closure kind: its evaluation (Cycles' formula), whether
     it is grey, its render cost in closures (an Oren-Nayar closure is one
     per channel), whether EEVEE counts it as a reflection closure (its
-    microfacet lobes; ``lut.render.eevee.EXACT_REFLECTION_CLOSURES``) and how
+    microfacet lobes; ``lut.render.eevee.EXACT_REFLECTION_CLOSURES``), how
     EEVEE's rendering of it is calibrated (``eevee``; None: an EEVEE fit
-    never uses it)."""
+    never uses it) and whether only OSL draws it, with a signed weight
+    (``osl``: the ramps' knots)."""
 
     evaluate: object
     grey: bool = False
     cost: int = 1
     reflection: bool = False
     eevee: EeveeResponse | None = None
+    osl: bool = False
 
 
 _DIFFUSE_EEVEE = EeveeResponse(_eevee_lambert)
@@ -384,6 +447,8 @@ CLOSURE_KINDS = {
         reflection=True,
         eevee=EeveeResponse(_eevee_retro_glossy, ("roughness",), {"roughness": RETRO_ROUGHNESS}),
     ),
+    "diffuse_ramp": ClosureKind(_diffuse_ramp, cost=0, osl=True),
+    "phong_ramp": ClosureKind(_phong_ramp, cost=0, osl=True),
 }
 
 

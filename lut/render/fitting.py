@@ -235,9 +235,16 @@ class Fit:
         return float(self.type["slope"]) > 0
 
     @property
+    def osl(self) -> bool:
+        """Whether it is the OSL variant of a Cycles fit (``fit_osl``): its
+        closures include signed ramp knots, which only OSL draws."""
+        return any(c.osl for c in self.closures)
+
+    @property
     def goals(self) -> tuple[float, float]:
-        """(whole, grazing band) goals of the measure for this fit."""
-        return measure.goals(self.target, not self.rough)
+        """(whole, grazing band) goals of the measure for this fit (the OSL
+        variant's are its own, ``measure.GOALS["OSL"]``)."""
+        return measure.goals("OSL" if self.osl else self.target, not self.rough)
 
     @property
     def target_error(self) -> float:
@@ -247,7 +254,7 @@ class Fit:
     def rows(self) -> list:
         """(closure index, component index) pairs that carry weight: the
         rows of the weights texture, bottom to top."""
-        used = self.weights.max(axis=(2, 3)) > 0
+        used = np.abs(self.weights).max(axis=(2, 3)) > 0  # a ramp knot's weight is signed
         return [(k, c) for k in range(len(self.closures)) for c in range(len(COMPONENTS)) if used[k, c]]
 
     def component_errors(self) -> dict:
@@ -738,6 +745,108 @@ def fit_lut(
     )
 
 
+# ---------------------------------------------------------------------- OSL ramps
+
+#: Phong ramp exponents of the OSL variant: one ``phong_ramp`` closure per
+#: exponent beside the one ``diffuse_ramp`` (``closures.ramp_closures``).
+OSL_EXPONENTS = (1.0, 8.0)
+#: Ridge of the ramp knots' least squares, relative to the mean diagonal of
+#: each view's Gram matrix: knots few rows reach (a Phong ramp's top knots
+#: at grazing views) stay near zero instead of following noise of the LUT.
+OSL_RIDGE = 1e-3
+#: Rows beyond the fitted domain where the variant's radiance is checked to
+#: be non-negative (lights to 89.9°: a diffuse ramp's first knot is its
+#: value at the horizon).
+OSL_CHECK_LIGHT = np.radians(89.9)
+
+
+def fit_osl(
+    lut, base: Fit, *, exponents=OSL_EXPONENTS, ridge=OSL_RIDGE, grid=LIGHT_GRID, row_set="hemisphere", nonnegative=True
+) -> Fit:
+    """The OSL variant of a Cycles fit ``base`` (``fit_lut``): its closures
+    and weights unchanged, plus the knots of one diffuse ramp and one Phong
+    ramp per exponent (``closures.ramp_closures``) with **signed** weights,
+    fitted per view, tile and component to the residual radiance the SVM
+    closures leave on the rows ``row_set`` (``ROW_SETS``) by ridge least
+    squares (``ridge``, ``OSL_RIDGE``).
+
+    Bounded so that no colour renders negative radiance: per view and
+    component the ramps' correction is scaled down until the component's
+    radiance (SVM closures plus ramps) is non-negative at every checked
+    light (the rows, and lights to ``OSL_CHECK_LIGHT``); a colour's radiance
+    is a sum of components with non-negative amplitudes, so every colour of
+    the type is non-negative there too.  The ramps are kept only where they
+    bring the fit nearer its goals on the measure (``shortfall`` against the
+    OSL goals, ``measure.GOALS["OSL"]``); otherwise the variant is ``base``
+    with zero ramps.  Where OSL is off, the add-on renders ``base``'s
+    closures alone: exactly the SVM fit.  A dispersive type (a weight per
+    channel: several tiles) keeps zero ramps: the ramps' weights texture
+    packs three knots into one texel's channels (``texels``)."""
+    if base.target != "CYCLES" or base.osl:
+        raise ValueError(f"base must be an SVM Cycles fit, got a {base.target}{' OSL' if base.osl else ''} fit")
+    ridge = float(ridge)
+    if not ridge >= 0:
+        raise ValueError(f"ridge must be >= 0, got {ridge!r}")
+    exponents = tuple(float(e) for e in exponents)
+    if any(not 0 <= e <= 1e3 for e in exponents):
+        raise ValueError(f"exponents must lie in [0, 1000], got {exponents!r}")
+    views = (len(base.cos_view) - 1) // VIEW_SUBDIVISION + 1
+    cos_view = view_cosines(views)
+    w_base = base.weights[:, :, ::VIEW_SUBDIVISION, :]  # the views the base was fitted at
+    theta_v = np.arccos(np.clip(cos_view, np.cos(MAX_VIEW), 1.0))
+    ramps = closures.ramp_closures(exponents)
+
+    def radiance_parts(theta_l, phi):
+        tv = np.broadcast_to(theta_v[:, None], theta_l.shape)
+        svm = np.stack([c.evaluate(theta_l, tv, phi) for c in base.closures], axis=-1)  # (M, R, K)
+        drawn = np.einsum("mrk,kcmt->mrtc", svm, w_base)
+        ramp = np.stack([c.evaluate(theta_l, tv, phi) for c in ramps], axis=-1)  # (M, R, Q)
+        return tv, drawn, ramp
+
+    theta_l, phi, row_w = _rows(validate_row_set(row_set), theta_v, grid)
+    tv, drawn, ramp = radiance_parts(theta_l, phi)
+    target = lut.components(theta_l, tv, phi) * np.cos(theta_l)[..., None, None]  # (M, R, T, C)
+    aw = ramp * row_w[..., None]
+    gram = np.einsum("mrq,mrs->mqs", aw, aw)
+    rhs = np.einsum("mrq,mrtc->mtcq", aw, (target - drawn) * row_w[..., None, None])
+    scale = np.trace(gram, axis1=1, axis2=2) / len(ramps)
+    lam = np.maximum(ridge * scale, 1e-12 * np.maximum(scale, 1e-300))
+    system = gram + lam[:, None, None] * np.eye(len(ramps))
+    knots = solve_spd(np.broadcast_to(system[:, None, None], (*rhs.shape, len(ramps))), rhs)  # (M, T, C, Q)
+    # Non-negative radiance: scale each (view, tile, component) correction
+    # by the largest factor <= 1 that keeps it so on the rows and beyond.
+    check_l, check_phi, _ = light_rows(theta_v, grid, max_light=OSL_CHECK_LIGHT)
+    checks = [(theta_l, drawn, ramp), (check_l, *radiance_parts(check_l, check_phi)[1:])]
+    factor = np.ones(knots.shape[:3])
+    for _, svm_part, ramp_part in checks if nonnegative else ():
+        corr = np.einsum("mrq,mtcq->mrtc", ramp_part, knots)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(corr < 0, np.maximum(svm_part, 0.0) / -corr, np.inf)
+        factor = np.minimum(factor, ratio.min(axis=1))
+    knots *= np.clip(factor, 0.0, 1.0)[..., None] * (1.0 - 1e-6)
+    weights = np.concatenate([w_base, np.transpose(knots, (3, 2, 0, 1))], axis=0)  # (K + Q, C, M, T)
+    basis = list(base.closures) + ramps
+    model = model_radiance(lut)
+    whole, band = measure_grams(model, basis, cos_view, weights, _cycles)
+    goals = measure.goals("OSL", base.mirror)
+    if base.weights.shape[3] > 1 or shortfall(whole, band, goals) >= shortfall(
+        (base.residual, base.reference), (base.grazing_residual, base.grazing_reference), goals
+    ):
+        weights[len(base.closures) :] = 0.0  # the ramps do not pay: the SVM fit as it is
+        whole, band = (base.residual, base.reference), (base.grazing_residual, base.grazing_reference)
+    dense = view_cosines(texture_views(views))
+    return dataclasses.replace(
+        base,
+        closures=basis,
+        cos_view=dense,
+        weights=resample_views(weights, cos_view, dense),
+        residual=whole[0],
+        reference=whole[1],
+        grazing_residual=band[0],
+        grazing_reference=band[1],
+    )
+
+
 def _viewport_spread(kept, weights, values, *, points, mirror, n, cos_view, calibration):
     """{component: per-pixel spread (``eevee.spread_of``) of EEVEE's render
     of closures ``kept`` with ``weights`` at ``eevee.VIEWPORT_SAMPLES``} for
@@ -897,15 +1006,18 @@ def _fit_rows(
 
 
 def fit_path(
-    lut_path, target="CYCLES", exact_metallic=True, calibration=None, eevee_mode=DEFAULT_EEVEE_MODE
+    lut_path, target="CYCLES", exact_metallic=True, calibration=None, eevee_mode=DEFAULT_EEVEE_MODE, osl=False
 ) -> pathlib.Path:
     """The weights file of a target beside its LUT:
     ``paintfit-cycles-f<FIT_VERSION>-<key>.exr`` (``paintfit-cycles4-…`` for
-    Blender 4.2-4.5's lobes), ``paintfit-eevee-…`` (``paintfit-eevee50-…``
+    Blender 4.2-4.5's lobes; ``paintfit-cyclesosl-…`` for the OSL variant,
+    ``fit_osl``), ``paintfit-eevee-…`` (``paintfit-eevee50-…``
     when fitted with Blender 5.0's measured EEVEE responses; a converged
     EEVEE fit ends its name with ``c``: ``paintfit-eevee50c-…``)."""
     lut_path = pathlib.Path(lut_path)
-    name = closures.validate_target(target).lower() + ("" if exact_metallic else "4")
+    if osl and target != "CYCLES":
+        raise ValueError(f"an OSL variant exists for target 'CYCLES' only, got {target!r}")
+    name = closures.validate_target(target).lower() + ("" if exact_metallic else "4") + ("osl" if osl else "")
     if target == "EEVEE" and calibration is not None:
         name += "".join(str(int(v)) for v in calibration[:2])
     if target == "EEVEE" and validate_eevee_mode(eevee_mode) == "CONVERGED":
@@ -913,11 +1025,41 @@ def fit_path(
     return lut_path.with_name(lut_path.name.replace("paintlut-", f"paintfit-{name}-f{FIT_VERSION}-"))
 
 
+def texels(basis, rows) -> list:
+    """The rows of a fit's weights texture, bottom to top, for closures
+    ``basis`` with weight rows ``rows`` (``Fit.rows``): ``(k, c)`` for an SVM
+    closure's row (its weight in all three channels, as a colour node reads
+    it), then for each OSL ramp (its knots, ``closures.ramp_closures``) and
+    component ``((k0, k1, k2), c)``: three knots' weights side by side in R,
+    G and B (None where a knot has none), so a ramp's eight knots take three
+    texture lookups, not eight.  A fit without ramps has one row per ``rows``
+    entry, as before."""
+    used = set(map(tuple, rows))
+    out = [(k, c) for k, c in map(tuple, rows) if not basis[k].osl]
+    families = {}
+    for k, closure in enumerate(basis):
+        if closure.osl:
+            families.setdefault((closure.kind, closure.exponent), []).append(k)
+    for knots in families.values():
+        for c in range(len(COMPONENTS)):
+            for start in range(0, len(knots), 3):
+                trio = tuple(k if (k, c) in used else None for k in knots[start : start + 3])
+                trio += (None,) * (3 - len(trio))
+                if any(k is not None for k in trio):
+                    out.append((trio, c))
+    return out
+
+
 def _image(fitted: Fit) -> np.ndarray:
-    rows = fitted.rows
-    image = np.zeros((max(len(rows), 1), len(fitted.cos_view), 3), dtype=np.float32)
-    for r, (k, c) in enumerate(rows):
-        image[r] = np.broadcast_to(fitted.weights[k, c], (len(fitted.cos_view), 3))
+    layout = texels(fitted.closures, fitted.rows)
+    image = np.zeros((max(len(layout), 1), len(fitted.cos_view), 3), dtype=np.float32)
+    for r, (k, c) in enumerate(layout):
+        if isinstance(k, tuple):
+            for channel, knot in enumerate(k):
+                if knot is not None:
+                    image[r, :, channel] = fitted.weights[knot, c, :, 0]
+        else:
+            image[r] = np.broadcast_to(fitted.weights[k, c], (len(fitted.cos_view), 3))
     return image[::-1]  # EXR rows run top to bottom
 
 
@@ -951,8 +1093,13 @@ def read_fit(path) -> Fit:
         basis = [Closure(**c) for c in h["closures"]]
         views, tiles = int(h["views"]), int(h["tiles"])
         weights = np.zeros((len(basis), len(COMPONENTS), views, tiles))
-        for r, (k, c) in enumerate(h["rows"]):
-            weights[k, c] = pixels[::-1][r, :, :tiles]
+        for r, (k, c) in enumerate(texels(basis, h["rows"])):
+            if isinstance(k, tuple):  # an OSL ramp's knots, one per channel (one tile)
+                for channel, knot in enumerate(k):
+                    if knot is not None:
+                        weights[knot, c, :, 0] = pixels[::-1][r, :, channel]
+            else:
+                weights[k, c] = pixels[::-1][r, :, :tiles]
         return Fit(
             target=h["target"],
             exact_metallic=bool(h["exact_metallic"]),

@@ -39,6 +39,9 @@ GRAZING = np.radians(60.0)
 GOALS = {
     "CYCLES": {"smooth": (0.02, 0.04), "rough": (0.05, 0.10)},
     "EEVEE": {"smooth": (0.03, 0.06), "rough": (0.08, 0.16)},
+    # Cycles with Open Shading Language on (CPU, OptiX): the SVM fit plus
+    # signed ramp closures (``lut.render.fitting.fit_osl``).
+    "OSL": {"smooth": (0.01, 0.02), "rough": (0.03, 0.06)},
 }
 
 

@@ -1,0 +1,133 @@
+"""Cycles' OSL variant (``lut.render.fitting.fit_osl``): the ramp closures'
+formulas, the signed fit's bound, its gain on paints nobody tuned for, and
+its weights file.  Numpy only; the renders are in test_osl_render.py."""
+
+import numpy as np
+import pytest
+
+from lut import bench
+from lut.render import bake as render_bake
+from lut.render import closures, fitting, measure
+
+#: A randomised set the fit was not tuned on (seeds other than the
+#: benchmarks'): rough and smooth paints over the panel's ranges, and dark
+#: facet-dominated ones.
+SET = bench.random_paints(8, seed=31) + bench.dark_paints(3, seed=32)
+
+
+@pytest.fixture(scope="module")
+def bakes(tmp_path_factory):
+    directory = tmp_path_factory.mktemp("osl")
+    return {label: (paint, render_bake.bake_for_render(paint, directory, targets=("CYCLES",), osl=True))
+            for label, paint in SET}  # fmt: skip
+
+
+def test_ramp_knots_are_the_ramps_of_cycles_osl():
+    """The knots' hats share every position (they sum to 1), so a ramp of
+    equal knots is Cycles' plain lobe: diffuse_ramp of white knots is 1/π
+    (no cos θl: the ramp is the whole light dependence), phong_ramp's is the
+    normalised Phong lobe (e + 2)/(2π)·(R·l)^e·cos θl."""
+    x = np.linspace(0.0, 1.0, 101)
+    np.testing.assert_allclose(sum(closures.ramp_hat(x, j) for j in range(closures.RAMP_KNOTS)), 1.0, atol=1e-12)
+    assert closures.ramp_hat(3 / 7, 3) == pytest.approx(1.0) and closures.ramp_hat(3.5 / 7, 3) == pytest.approx(0.5)
+    tl, tv, ph = np.array([0.3, 1.2, 0.7]), np.array([0.4, 0.2, 1.1]), np.array([0.0, 2.0, 0.5])
+    diffuse = sum(c.evaluate(tl, tv, ph) for c in closures.ramp_closures(()))
+    np.testing.assert_allclose(diffuse, 1.0 / np.pi)
+    e = 8.0
+    phong = sum(c.evaluate(tl, tv, ph) for c in closures.ramp_closures((e,)) if c.kind == "phong_ramp")
+    r_dot_l = np.sin(tv) * np.cos(ph) * np.sin(tl) + np.cos(tv) * np.cos(tl)
+    expected = np.where(r_dot_l > 0, (e + 2) / (2 * np.pi) * np.maximum(r_dot_l, 0) ** e * np.cos(tl), 0.0)
+    np.testing.assert_allclose(phong, expected, atol=1e-12)
+    # One knot alone: its hat at the ramp's position (cos θl = 2/7 is knot 2's peak).
+    knot = closures.Closure("diffuse_ramp", knot=2)
+    assert knot.evaluate(np.arccos(2 / 7), 0.3, 0.0) == pytest.approx(1 / np.pi)
+    assert knot.evaluate(np.arccos(4 / 7), 0.3, 0.0) == pytest.approx(0.0)
+
+
+def test_the_variant_keeps_the_svm_closures_and_never_renders_negative(bakes):
+    """The variant's SVM closures and weights are the SVM fit's (a scene
+    without OSL renders exactly the SVM fit), and for random colours of each
+    type its radiance is nowhere negative beyond the measure's grid: lights
+    to 89°, every view to 80°, every azimuth."""
+    rng = np.random.default_rng(5)
+    tl, tv, ph = np.meshgrid(np.radians(np.arange(0, 90, 2.0)), np.radians(np.arange(0, 81, 5.0)),
+                             np.radians(np.arange(0, 181, 10.0)), indexing="ij")  # fmt: skip
+    for label, (_paint, result) in bakes.items():
+        svm, variant = result.fits["CYCLES"], result.osl
+        k = len(svm.closures)
+        assert variant.closures[:k] == svm.closures
+        np.testing.assert_allclose(variant.weights[:k], svm.weights, atol=1e-5 * np.abs(svm.weights).max())
+        assert variant.osl and all(c.osl for c in variant.closures[k:])
+        for _ in range(4):
+            amps = rng.uniform(0.0, 1.0, (3, 3))
+            radiance = variant.radiance(amps, tl.ravel(), tv.ravel(), ph.ravel())
+            scale = np.abs(svm.radiance(amps, tl.ravel(), tv.ravel(), ph.ravel())).max()
+            assert radiance.min() >= -1e-4 * scale, (label, radiance.min(), scale)
+
+
+def test_the_ramps_lower_the_measure_on_paints_nobody_tuned_for(bakes):
+    """Reported on the measure (whole and grazing band), the variant is never
+    further from its goals than the SVM fit, and on most rough paints of the
+    set it is nearer the paint: the median of the whole figure falls by a
+    tenth at least."""
+    gains = []
+    for label, (paint, result) in bakes.items():
+        errors = result.all_errors(paint)
+        svm, osl = errors["CYCLES"], errors[render_bake.OSL_VARIANT]
+        goals = measure.goals("OSL", paint.slope == 0)
+        assert (
+            max(o / g for o, g in zip(osl, goals, strict=True))
+            <= max(s / g for s, g in zip(svm, goals, strict=True)) + 1e-9
+        ), (label, svm, osl)
+        if paint.slope > 0:
+            gains.append(osl[0] / svm[0])
+    assert np.median(gains) < 0.9, gains
+
+
+def test_the_variants_file_packs_three_knots_a_texel_and_reads_back(bakes, tmp_path):
+    """A ramp's eight knots take three texels per component (R, G, B), the
+    file reads back the weights it was written with, and a bake finds it
+    cached; the SVM fit's own file keeps one row per weight row."""
+    paint, result = next(iter(bakes.values()))
+    variant = result.osl
+    layout = fitting.texels(variant.closures, variant.rows)
+    packed = [entry for entry in layout if isinstance(entry[0], tuple)]
+    ramp_rows = [r for r in variant.rows if variant.closures[r[0]].osl]
+    families = {(variant.closures[k].kind, variant.closures[k].exponent) for k, _ in ramp_rows}
+    assert ramp_rows and sum(k is not None for trio, _ in packed for k in trio) == len(ramp_rows)
+    assert len(packed) <= 3 * len(fitting.COMPONENTS) * len(families)
+    assert len(layout) == len(variant.rows) - len(ramp_rows) + len(packed)
+    back = fitting.read_fit(result.osl_path)
+    np.testing.assert_allclose(back.weights, variant.weights, atol=1e-5 * np.abs(variant.weights).max())
+    assert back.closures == variant.closures and back.osl
+    assert result.osl_path.name.startswith("paintfit-cyclesosl-")
+    again = render_bake.bake_for_render(paint, result.lut_path.parent, targets=("CYCLES",), osl=True)
+    assert again.computed == []
+    svm = result.fits["CYCLES"]
+    assert fitting.texels(svm.closures, svm.rows) == [tuple(r) for r in svm.rows]
+
+
+def test_the_variant_needs_cycles_and_an_svm_base(bakes):
+    paint, result = next(iter(bakes.values()))
+    with pytest.raises(ValueError, match="osl=True needs 'CYCLES'"):
+        render_bake.bake_for_render(paint, result.lut_path.parent, targets=("EEVEE",), osl=True)
+    with pytest.raises(ValueError, match="base must be an SVM Cycles fit"):
+        fitting.fit_osl(result.lut, result.osl)
+    with pytest.raises(ValueError, match="exponents must lie in"):
+        fitting.fit_osl(result.lut, result.fits["CYCLES"], exponents=(-1.0,))
+    with pytest.raises(ValueError, match="target 'CYCLES' only"):
+        fitting.fit_path(result.lut_path, "EEVEE", osl=True)
+
+
+def test_the_variants_radiance_is_what_its_reported_error_measures(bakes):
+    """``Fit.radiance`` of the variant (the SVM closures and the ramps, with
+    the weights its texture gives) against the model on the measure's grid
+    gives the figures the variant reports, whole and over the grazing band."""
+    for label, (paint, result) in bakes.items():
+        amps = result.lut.amplitudes(paint)
+        tl, tv, ph = measure.points(paint.slope == 0)
+        model = paint.brdf(tl, tv, ph) * np.cos(tl)[:, None]
+        measured = measure.errors(result.osl.radiance(amps, tl, tv, ph), model, tl)
+        reported = result.all_errors(paint)[render_bake.OSL_VARIANT]
+        for got, promised in zip(measured, reported, strict=True):
+            assert got == pytest.approx(promised, rel=0.03, abs=0.003), (label, measured, reported)
