@@ -17,7 +17,8 @@ budget without extra closures, beside the default (``BUDGET`` and
 ``--set dark`` the dark, facet-dominated rough paints of
 ``lut.bench.dark_paints``.  Cycles is fitted as Blender 5 renders it
 (exact dielectric Metallic lobes) and as Blender 4.2-4.5 do (GGX lobes);
-EEVEE against Blender 5.0's measured closure responses."""
+EEVEE against Blender 5.0's measured closure responses; "OSL" is Cycles'
+OSL variant (``lut.render.fitting.fit_osl``), against its own goals."""
 
 from __future__ import annotations
 
@@ -82,11 +83,11 @@ def budget_tradeoff(paints, directory, budgets):
 
 
 def fidelity(paints, directory):
-    """[(label, paint, {"CYCLES", "CYCLES 4.x", "EEVEE": reported (whole,
-    grazing band) error})]."""
+    """[(label, paint, {"CYCLES", "OSL" (Cycles' OSL variant), "CYCLES 4.x",
+    "EEVEE": reported (whole, grazing band) error})]."""
     rows = []
     for label, paint in paints:
-        errors = render_bake.bake_for_render(paint, directory, eevee_calibration=(5, 0)).all_errors(paint)
+        errors = render_bake.bake_for_render(paint, directory, eevee_calibration=(5, 0), osl=True).all_errors(paint)
         errors["CYCLES 4.x"] = render_bake.bake_for_render(
             paint, directory, targets=("CYCLES",), exact_metallic=False
         ).all_errors(paint)["CYCLES"]
@@ -146,7 +147,7 @@ def main(argv=None) -> int:
     paints = SETS[args.set](args.count, **kwargs)
     with tempfile.TemporaryDirectory() as tmp:
         rows = fidelity(paints, pathlib.Path(tmp))
-    keys = ("CYCLES", "CYCLES 4.x", "EEVEE")
+    keys = ("CYCLES", "OSL", "CYCLES 4.x", "EEVEE")
     print("| paint | " + " | ".join(f"{k} | {k} grazing" for k in keys) + " |")
     print("|---" * (2 * len(keys) + 1) + "|")
     for label, _, errors in rows:
@@ -163,7 +164,7 @@ def main(argv=None) -> int:
         if not chosen:
             continue
         for key in keys:
-            goals = measure.goals("EEVEE" if key == "EEVEE" else "CYCLES", not rough)
+            goals = measure.goals({"EEVEE": "EEVEE", "OSL": "OSL"}.get(key, "CYCLES"), not rough)
             for band, goal in zip(BANDS, goals, strict=True):
                 which = BANDS.index(band)
                 values = np.array([e[key][which] for _, e in chosen])

@@ -21,19 +21,26 @@ from . import closures, fitting
 
 #: Share of the progress bar taken by the LUT (the fits take the rest).
 LUT_SHARE = 0.7
+#: The name of Cycles' OSL variant among a bake's fits and errors
+#: (``RenderBake.variants``; its goals are ``measure.GOALS["OSL"]``).
+OSL_VARIANT = "OSL"
 
 
 @dataclasses.dataclass
 class RenderBake:
     """The result of ``bake_for_render``: the LUT, its loaded content, and
     per target the fit and its weights file; ``computed`` lists what was
-    computed (the rest came from valid cached files)."""
+    computed (the rest came from valid cached files).  ``osl`` and
+    ``osl_path``: Cycles' OSL variant (``lut.render.fitting.fit_osl``) and
+    its weights file, where asked for (else None)."""
 
     lut_path: pathlib.Path
     lut: baking.LUT
     fits: dict
     fit_paths: dict
     computed: list
+    osl: fitting.Fit | None = None
+    osl_path: pathlib.Path | None = None
 
     @property
     def key(self) -> str:
@@ -50,16 +57,22 @@ class RenderBake:
         the grazing band, θl >= 60° (``Fit.grazing_error``)}."""
         return {target: band for target, (_, band) in self.all_errors(paint).items()}
 
+    def variants(self) -> dict:
+        """{name: fit}: each target's fit, and Cycles' OSL variant as "OSL"
+        where it was baked (``OSL_VARIANT``)."""
+        return {**self.fits, **({OSL_VARIANT: self.osl} if self.osl is not None else {})}
+
     def all_errors(self, paint: Paint) -> dict:
         """{target: (whole, grazing band)}: the fidelity measure each fit
-        reports for this paint (``lut.render.fitting.reported_errors``)."""
+        reports for this paint (``lut.render.fitting.reported_errors``),
+        the OSL variant's as "OSL" where it was baked."""
         amps = self.lut.amplitudes(paint)
-        return {target: fitting.reported_errors(fit.grams(), amps) for target, fit in self.fits.items()}
+        return {target: fitting.reported_errors(fit.grams(), amps) for target, fit in self.variants().items()}
 
 
-def _cached_fit(path, lut, target, exact_metallic, calibration, eevee_mode="EXACT"):
+def _cached_fit(path, lut, target, exact_metallic, calibration, eevee_mode="EXACT", osl=False):
     """The fit stored at ``path`` if it is valid and belongs to this LUT,
-    target, calibration and EEVEE mode, else None."""
+    target, calibration, EEVEE mode and variant (SVM or OSL), else None."""
     if not pathlib.Path(path).exists():
         return None
     try:
@@ -68,7 +81,7 @@ def _cached_fit(path, lut, target, exact_metallic, calibration, eevee_mode="EXAC
         return None
     if fitted.lut_key != lut.key or fitted.target != target or fitted.exact_metallic != exact_metallic:
         return None
-    if fitted.calibration != calibration or fitted.eevee_mode != eevee_mode:
+    if fitted.calibration != calibration or fitted.eevee_mode != eevee_mode or fitted.osl != osl:
         return None
     return fitted
 
@@ -91,6 +104,7 @@ def bake_for_render(
     exact_metallic=True,
     eevee_calibration=None,
     eevee_mode=fitting.DEFAULT_EEVEE_MODE,
+    osl=False,
     force=False,
     progress=None,
     **lut_options,
@@ -101,10 +115,14 @@ def bake_for_render(
     the Blender line whose measured EEVEE closure responses the EEVEE fit
     uses (``lut.render.eevee.calibration_for(bpy.app.version)``; None: Cycles'
     formulas); ``eevee_mode``: "EXACT" or "CONVERGED"
-    (``lut.render.fitting.EEVEE_MODES``).  ``progress(fraction)``
+    (``lut.render.fitting.EEVEE_MODES``); ``osl``: also Cycles' OSL variant
+    (``lut.render.fitting.fit_osl``, from the Cycles fit; Cycles must be a
+    target), as ``RenderBake.osl``.  ``progress(fraction)``
     (0..1) is called throughout and may raise to cancel: files already
     complete stay (they are valid caches), nothing is half-written."""
     targets = [closures.validate_target(t) for t in targets]
+    if osl and "CYCLES" not in targets:
+        raise ValueError(f"osl=True needs 'CYCLES' among the targets, got {targets!r}")
     eevee_mode = fitting.validate_eevee_mode(eevee_mode)
     report = progress or (lambda fraction: None)
     computed = []
@@ -118,7 +136,6 @@ def bake_for_render(
     if force or before is None or _identity(path) != before:  # a damaged file baked again is computed too
         computed.append("lut")
     report(LUT_SHARE)
-    fits, paths = {}, {}
     fits, paths, todo = {}, {}, {}
     for target in targets:
         calibration = tuple(eevee_calibration) if (target == "EEVEE" and eevee_calibration) else None
@@ -151,8 +168,50 @@ def bake_for_render(
                 future.cancel()
             raise
     fits = {target: fits[target] for target in targets}
-    computed.sort(key=lambda name: ["lut", *targets].index(name))
-    return RenderBake(path, table, fits, paths, computed)
+    variant = variant_path = None
+    if osl:
+        variant_path = fitting.fit_path(path, "CYCLES", exact_metallic, osl=True)
+        fresh = force or "CYCLES" in computed  # the variant is made from this Cycles fit
+        variant = None if fresh else _cached_fit(variant_path, table, "CYCLES", exact_metallic, None, osl=True)
+        if variant is None:
+            variant = fitting.fit_osl(table, fits["CYCLES"])
+            fitting.write_fit(variant, variant_path)
+            computed.append(OSL_VARIANT)
+    computed.sort(key=lambda name: ["lut", *targets, OSL_VARIANT].index(name))
+    report(1.0)
+    return RenderBake(path, table, fits, paths, computed, variant, variant_path)
+
+
+def load_baked(
+    lut_path, *, targets=closures.TARGETS, exact_metallic=True, eevee_calibration=None,
+    eevee_mode=fitting.DEFAULT_EEVEE_MODE, osl=False,
+) -> RenderBake:  # fmt: skip
+    """The ``RenderBake`` of a LUT already baked at ``lut_path`` and its
+    targets' fits (the options as for ``bake_for_render``), from their
+    files; Cycles' OSL variant (``osl``) is made from the Cycles fit where
+    it has no valid file yet (a tenth of a second).  Raises lut.LUTError
+    where the LUT or a fit is missing, damaged or of another bake."""
+    path = pathlib.Path(lut_path)
+    targets = [closures.validate_target(t) for t in targets]
+    eevee_mode = fitting.validate_eevee_mode(eevee_mode)
+    table = baking.load_lut(path)
+    fits, paths, computed = {}, {}, []
+    for target in targets:
+        calibration = tuple(eevee_calibration) if (target == "EEVEE" and eevee_calibration) else None
+        mode = eevee_mode if target == "EEVEE" else "EXACT"
+        paths[target] = fitting.fit_path(path, target, exact_metallic, calibration, mode)
+        fits[target] = _cached_fit(paths[target], table, target, exact_metallic, calibration, mode)
+        if fits[target] is None:
+            raise lutfile.LUTError(f"{paths[target]}: no valid {target} fit of {path.name}: bake the paint")
+    variant = variant_path = None
+    if osl and "CYCLES" in fits:
+        variant_path = fitting.fit_path(path, "CYCLES", exact_metallic, osl=True)
+        variant = _cached_fit(variant_path, table, "CYCLES", exact_metallic, None, osl=True)
+        if variant is None:
+            variant = fitting.fit_osl(table, fits["CYCLES"])
+            fitting.write_fit(variant, variant_path)
+            computed.append(OSL_VARIANT)
+    return RenderBake(path, table, fits, paths, computed, variant, variant_path)
 
 
 def node_inputs(paint: Paint, internal_reflectance: float | None = None) -> dict:
