@@ -122,7 +122,9 @@ def test_the_variant_needs_cycles_and_an_svm_base(bakes):
 def test_the_variants_radiance_is_what_its_reported_error_measures(bakes):
     """``Fit.radiance`` of the variant (the SVM closures and the ramps, with
     the weights its texture gives) against the model on the measure's grid
-    gives the figures the variant reports, whole and over the grazing band."""
+    gives the figures the variant reports, whole and over the grazing band,
+    within 0.2% (the fit measures against the model at its LUT's quadrature
+    sizes, ``Paint.brdf`` at its own defaults)."""
     for label, (paint, result) in bakes.items():
         amps = result.lut.amplitudes(paint)
         tl, tv, ph = measure.points(paint.slope == 0)
@@ -130,4 +132,4 @@ def test_the_variants_radiance_is_what_its_reported_error_measures(bakes):
         measured = measure.errors(result.osl.radiance(amps, tl, tv, ph), model, tl)
         reported = result.all_errors(paint)[render_bake.OSL_VARIANT]
         for got, promised in zip(measured, reported, strict=True):
-            assert got == pytest.approx(promised, rel=0.03, abs=0.003), (label, measured, reported)
+            assert abs(got - promised) <= 0.002, (label, measured, reported)

@@ -281,7 +281,7 @@ class Fit:
         tl, tv, ph = (np.ravel(np.asarray(a, dtype=float)) for a in (theta_l, theta_v, phi))
         evaluate = evaluator_for(self.target, self.calibration)
         values = np.array([evaluate(c, tl, tv, ph) for c in self.closures]).reshape(len(self.closures), tl.size)
-        comps = np.einsum("kn,kcnt->ntc", values, texture_weights(self.weights, self.cos_view, np.cos(tv)))
+        comps = np.einsum("kn,kcnt->ntc", values, self.weights[:, :, nearest_column(len(self.cos_view), np.cos(tv)), :])
         tiles = comps.shape[1]
         amps = np.asarray(amplitudes, dtype=float)
         return np.einsum("nkc,kc->nk", comps[:, [k if tiles == 3 else 0 for k in range(3)], :], amps)
@@ -572,6 +572,12 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None, star
 # ---------------------------------------------------------------------- fit
 
 
+def nearest_column(columns: int, cos_v) -> np.ndarray:
+    """The column of a weights texture of ``columns`` columns (cos θv =
+    j/(columns - 1)) that a Closest lookup at view cosines ``cos_v`` reads."""
+    return np.clip(np.rint(np.asarray(cos_v) * (columns - 1)).astype(int), 0, columns - 1)
+
+
 def texture_weights(weights, cos_view, cos_v):
     """The weights (K, C, N, T) a node group reads at view cosines ``cos_v``
     (N,) from a fit's weights at ``cos_view`` (M): the column of its weights
@@ -579,8 +585,7 @@ def texture_weights(weights, cos_view, cos_v):
     weights resampled linearly to ``texture_views(M)`` columns."""
     columns = view_cosines(texture_views(len(cos_view)))
     texture = resample_views(weights, cos_view, columns)
-    nearest = np.clip(np.rint(np.asarray(cos_v) * (len(columns) - 1)).astype(int), 0, len(columns) - 1)
-    return texture[:, :, nearest, :]
+    return texture[:, :, nearest_column(len(columns), cos_v), :]
 
 
 @functools.lru_cache(maxsize=4)
