@@ -15,7 +15,7 @@ import typing
 
 import bpy
 
-from . import export, nodes, properties, validation
+from . import export, nodes, osl, properties, validation
 from ._lut import closures, eevee, fitting, lut, measure, render_bake
 from .live import _loaded_lut, paint_of, update_inputs, working_space  # noqa: F401  (the API's names)
 
@@ -118,6 +118,46 @@ def eevee_calibration():
     return eevee.calibration_for(bpy.app.version)
 
 
+#: The name of Cycles' OSL variant among a material's fit errors
+#: (``fit_errors``, ``lut.render.bake.OSL_VARIANT``).
+OSL_VARIANT = render_bake.OSL_VARIANT
+
+
+def switch_variant(material) -> None:
+    """Wire a baked material to the Cycles group its OSL setting asks for
+    (the variant's or the SVM one), from its cached bake; a material not
+    baked, or stale, takes it at its next bake.  Called when the setting
+    changes (``properties.PaintLUTSettings.osl``)."""
+    settings = material.paint_lut
+    if settings.stale or not settings.lut_path:
+        return
+    try:
+        result = render_bake.load_baked(
+            bpy.path.abspath(settings.lut_path), targets=engine_targets(), exact_metallic=nodes.EXACT_METALLIC,
+            eevee_calibration=eevee_calibration(), eevee_mode=eevee_mode(), osl=True,
+        )  # fmt: skip
+        store_result(material, paint_of(material), result, clear_stale=False)
+    except (ValueError, OSError, lut.LUTError):
+        settings.stale = True  # the bake's files are gone or damaged: it needs a bake (the panel says so)
+
+
+properties.OSL_SWITCHED.append(switch_variant)
+
+
+def cycles_variant(material, scene=None) -> str:
+    """What Cycles draws of a material in a scene: "OSL" (its OSL variant:
+    the material's setting is on, the bake has it and the scene renders
+    Open Shading Language, ``osl.renders_osl``) or "SVM" (its SVM closures:
+    the setting is off, or the scene renders SVM, where the variant's
+    Script node draws nothing and the SVM closures alone render)."""
+    scene = scene if scene is not None else getattr(bpy.context, "scene", None)
+    if not material.paint_lut.osl or scene is None or not osl.renders_osl(scene):
+        return "SVM"
+    node = nodes.group_of(material, "CYCLES")
+    drawn = node is not None and any(nd.type == "SCRIPT" for nd in node.node_tree.nodes)
+    return OSL_VARIANT if drawn else "SVM"
+
+
 def eevee_mode(scene=None) -> str:
     """How the scene's EEVEE draws paint materials (its Paint LUT setting,
     ``lut.render.fitting.EEVEE_MODES``): "CONVERGED" (the default; more
@@ -144,6 +184,8 @@ def store_result(material, paint: lut.Paint, result: render_bake.RenderBake, exa
     groups = {
         target: nodes.build_group(fit, result.fit_paths[target], exact_metallic) for target, fit in result.fits.items()
     }
+    if settings.osl and result.osl is not None and "CYCLES" in groups:  # Cycles' OSL variant (addon.osl)
+        groups["CYCLES"] = nodes.build_group(result.osl, result.osl_path, exact_metallic)
     nodes.wire(material, groups, render_bake.node_inputs(paint, result.lut.internal_reflectance))
     settings.internal_reflectance = result.lut.internal_reflectance
     settings.diffuse_albedo = render_bake.diffuse_albedo(result.lut)
@@ -154,7 +196,7 @@ def store_result(material, paint: lut.Paint, result: render_bake.RenderBake, exa
                 **f.grams(), "goal": f.target_error, "goals": list(f.goals),
                 **(_drawing(f) if target == "EEVEE" else {}),
             }
-            for target, f in result.fits.items()
+            for target, f in result.variants().items()
         }
     )  # fmt: skip
     export.update_fallback(material, paint)
@@ -173,7 +215,8 @@ def bake_material(material, *, directory=None, force=False, exact_metallic=None,
     paint = paint_of(material)
     result = render_bake.bake_for_render(
         paint, directory or lut_directory(), targets=engine_targets(), exact_metallic=exact,
-        eevee_calibration=eevee_calibration(), eevee_mode=eevee_mode(), force=force, progress=progress, **options,
+        eevee_calibration=eevee_calibration(), eevee_mode=eevee_mode(), osl=True, force=force, progress=progress,
+        **options,
     )  # fmt: skip
     store_result(material, paint, result, exact)
     material.paint_lut.enabled = True
@@ -193,13 +236,15 @@ def finish_background_bake(material, paint, result, type_key_at_start) -> bool:
     return current
 
 
-def fit_errors(material) -> dict:
+def fit_errors(material, *, variants=False) -> dict:
     """{engine: FitError} of the material's current colours against its
     bake's fits: the fidelity measure (``lut.render.measure``) over its whole
     grid and over the grazing band, with their goals
-    (``lut.render.fitting.reported_errors``); empty before a bake.  A bake
-    stored without the grazing band's matrices (an earlier release) reports
-    the whole figure for the band too."""
+    (``lut.render.fitting.reported_errors``); empty before a bake.  Cycles'
+    OSL variant is "OSL" (``OSL_VARIANT``) where the material uses it, or
+    with ``variants`` wherever it was baked (what the variant would render).
+    A bake stored without the grazing band's matrices (an earlier release)
+    reports the whole figure for the band too."""
     settings = material.paint_lut
     if not settings.fits or settings.internal_reflectance <= 0:
         return {}
@@ -213,6 +258,8 @@ def fit_errors(material) -> dict:
     )
     out = {}
     for target, f in fits.items():
+        if target == OSL_VARIANT and not (variants or settings.osl):
+            continue
         whole, grazing = fitting.reported_errors(f, amps)
         kind = measure.goals(target, paint.slope == 0)  # an earlier release stored the whole goal alone
         goals = f.get("goals") or (f.get("goal", kind[0]), kind[1])
@@ -220,11 +267,14 @@ def fit_errors(material) -> dict:
     return out
 
 
-def _result_errors(result: render_bake.RenderBake, paint) -> dict:
-    """{engine: FitError} of a bake's fits at a paint's colours."""
+def _result_errors(result: render_bake.RenderBake, paint, osl=False) -> dict:
+    """{engine: FitError} of a bake's fits at a paint's colours (Cycles' OSL
+    variant too with ``osl``: a material that uses it)."""
     out = {}
     for target, (whole, grazing) in result.all_errors(paint).items():
-        fit = result.fits[target]
+        if target == OSL_VARIANT and not osl:
+            continue
+        fit = result.variants()[target]
         out[target] = FitError(whole, fit.goals[0], grazing, fit.goals[1], **_drawn(target, _drawing(fit), whole))
     return out
 
@@ -390,7 +440,8 @@ def is_current(material, paint, *, directory=None, exact_metallic=None, **option
         if not path.stem.endswith(table.key[:24]):  # another type's LUT renamed onto this one's name
             return False
         for target in engine_targets():
-            fit_file = lut.render.fitting.fit_path(path, target, exact, eevee_calibration(), eevee_mode())
+            variant = target == "CYCLES" and settings.osl  # the Cycles group draws the OSL variant
+            fit_file = lut.render.fitting.fit_path(path, target, exact, eevee_calibration(), eevee_mode(), osl=variant)
             fitted = lut.render.fitting.read_fit(fit_file)
             if fitted.lut_key != table.key or fitted.target != target:
                 return False
@@ -429,7 +480,7 @@ def bake_materials(used, force=False, *, directory=None, exact_metallic=None, **
                 status[material.name] = _status("cached", errors, key)
                 continue
             result = bake_material(material, directory=directory, force=force, exact_metallic=exact_metallic, **options)
-            errors = _result_errors(result, paint)
+            errors = _result_errors(result, paint, material.paint_lut.osl)
             status[material.name] = _status("baked", errors, result.lut_path.stem.split("-")[-1])
         except (ValueError, OSError, RuntimeError, TypeError, KeyError) as exc:
             status[material.name] = BakeStatus("failed", str(exc) or type(exc).__name__)

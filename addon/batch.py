@@ -220,15 +220,22 @@ def _fit_entry(material) -> dict:
         }
         for t, f in errors.items()
     }
+    # What Cycles draws of it in the file's scene: "OSL" (its OSL variant,
+    # whose errors are listed as "OSL") or "SVM".
+    entry["cycles_variant"] = api.cycles_variant(material)
     misses = []
     for t, f in errors.items():
         if f.error > f.target:
-            misses.append(f"{t.title()} {100 * f.error:.1f}% > {100 * f.target:.0f}%")
+            misses.append(f"{_label(t)} {100 * f.error:.1f}% > {100 * f.target:.0f}%")
         if f.grazing > f.grazing_target:
-            misses.append(f"{t.title()} grazing light {100 * f.grazing:.1f}% > {100 * f.grazing_target:.0f}%")
+            misses.append(f"{_label(t)} grazing light {100 * f.grazing:.1f}% > {100 * f.grazing_target:.0f}%")
     if misses:
         entry["fit_misses"] = misses
     return entry
+
+
+def _label(target: str) -> str:
+    return "Cycles OSL" if target == api.OSL_VARIANT else target.title()
 
 
 def shared_bakes(materials: dict) -> dict:

@@ -29,6 +29,7 @@ import pathlib
 
 import bpy
 
+from . import osl
 from ._lut import closures, fitting, lutfile
 
 GROUP_PREFIX = "Paint LUT"
@@ -86,6 +87,7 @@ def group_name(fit: fitting.Fit) -> str:
     else:
         surface = "smooth"
     engine = "" if fit.target == "CYCLES" else f" {fit.target.title()}"
+    engine += " OSL" if fit.osl else ""  # Cycles' OSL variant: a group of its own beside the SVM one
     return f"{GROUP_PREFIX} n{float(fit.n):g} {surface} g{float(t.get('g', 0)):g} {fit.lut_key[:8]}{engine}"
 
 
@@ -166,13 +168,15 @@ def build_group(fit: fitting.Fit, weights_path, exact_metallic=None):
     u = _view_lookup(tree, links, lay, len(fit.cos_view))
     amps = _amplitudes(tree, links, lay, inputs, fit.internal_reflectance)
     image = _image(weights_path)
-    rows = fit.rows
-    textures = {}
+    rows = fitting.texels(fit.closures, fit.rows)
+    textures, ramps = {}, {}
     for r, (k, c) in enumerate(rows):
         coord = lay.place(tree.nodes.new("ShaderNodeCombineXYZ"), "weights", "Weights per view")
         links.new(u, coord.inputs["X"])
         coord.inputs["Y"].default_value = (r + 0.5) / len(rows)
-        coord.label = f"{fit.closures[k].kind} {fitting.COMPONENTS[c]}"
+        ramp = isinstance(k, tuple)  # three knots of an OSL ramp, in R, G, B
+        first = next(j for j in k if j is not None) if ramp else k
+        coord.label = f"{fit.closures[first].kind} {fitting.COMPONENTS[c]}"
         tex = lay.place(tree.nodes.new("ShaderNodeTexImage"), "weights", "Weights per view")
         tex.image = image
         # Closest: the texture's columns are dense (fitting.TEXTURE_VIEWS);
@@ -180,13 +184,19 @@ def build_group(fit: fitting.Fit, weights_path, exact_metallic=None):
         tex.interpolation = "Closest"
         tex.extension = "EXTEND"
         links.new(coord.outputs[0], tex.inputs["Vector"])
-        textures[(k, c)] = tex.outputs["Color"]
+        if ramp:
+            ramps[(first, c)] = tex.outputs["Color"]
+        else:
+            textures[(k, c)] = tex.outputs["Color"]
     total = None
     for k, closure in enumerate(fit.closures):
         rows_k = [(c, textures[(k, c)]) for c in range(len(fitting.COMPONENTS)) if (k, c) in textures]
         if not rows_k:
             continue
         shader = NODE_BUILDERS[closure.kind](tree, links, lay, closure, rows_k, amps, exact_metallic)
+        total = shader if total is None else _add(tree, links, lay, total, shader)
+    if ramps:
+        shader = _osl_ramps(tree, links, lay, fit, ramps, amps)
         total = shader if total is None else _add(tree, links, lay, total, shader)
     if fit.mirror:
         make = _metallic_node if exact_metallic_default(exact_metallic) else _principled_node
@@ -426,7 +436,33 @@ def _oren_nayar(tree, links, lay, closure, rows_k, amps, exact_metallic):
     return total
 
 
-#: How each closure kind of ``lut.render.closures.CLOSURE_KINDS`` is built.
+def _osl_ramps(tree, links, lay, fit, ramps, amps):
+    """The OSL variant's ramps: one Script node (``osl.ramps_node``) fed the
+    colour amplitudes and, per ramp, component and trio of knots, the
+    texel that holds their weights ({(first knot's closure index,
+    component): texture colour})."""
+    node = lay.place(osl.ramps_node(tree), "closures", "Closures")
+    for name, socket in osl.AMPLITUDES.items():
+        links.new(amps[name], node.inputs[socket])
+    families = []
+    for closure in fit.closures:
+        family = (closure.kind, closure.exponent) if closure.osl else None
+        if family is not None and family not in families:
+            families.append(family)
+    if len(families) > len(osl.FAMILIES) or (families and families[0][0] != "diffuse_ramp"):
+        raise ValueError(f"the OSL ramps shader draws one diffuse and two Phong ramps, not {families}")
+    letter = dict(zip(families, osl.FAMILIES[: len(families)], strict=True))
+    for (k, c), colour in ramps.items():
+        closure = fit.closures[k]
+        family = letter[(closure.kind, closure.exponent)]
+        links.new(colour, node.inputs[osl.weight_input(family, fitting.COMPONENTS[c], closure.knot // 3)])
+        if family in osl.EXPONENTS:
+            node.inputs[osl.EXPONENTS[family]].default_value = closure.exponent
+    return node.outputs[osl.OUTPUT]
+
+
+#: How each closure kind of ``lut.render.closures.CLOSURE_KINDS`` is built
+#: (the OSL ramps' knots all by one Script node, ``_osl_ramps``).
 NODE_BUILDERS = {
     "lambert": _coloured("ShaderNodeBsdfDiffuse", _setup_lambert),
     "diffuse_toon": _coloured("ShaderNodeBsdfToon", _setup_toon),
@@ -439,7 +475,7 @@ NODE_BUILDERS = {
     "oren_nayar": _oren_nayar,
     "retro_glossy": _retro_glossy,
 }
-assert set(NODE_BUILDERS) == set(closures.CLOSURE_KINDS)
+assert set(NODE_BUILDERS) == {kind for kind, spec in closures.CLOSURE_KINDS.items() if not spec.osl}
 
 
 def build_seen_group(fit: fitting.Fit, albedo: float):

@@ -38,7 +38,8 @@ class PAINTLUT_OT_bake(bpy.types.Operator):
         self._type_key = self._material.paint_lut.type_key()
         self._job = jobs.BakeJob(
             paint, api.lut_directory(), exact_metallic=nodes.EXACT_METALLIC, targets=api.engine_targets(),
-            eevee_calibration=api.eevee_calibration(), eevee_mode=api.eevee_mode(context.scene), force=self.force,
+            eevee_calibration=api.eevee_calibration(), eevee_mode=api.eevee_mode(context.scene), osl=True,
+            force=self.force,
         ).start()  # fmt: skip
         wm = context.window_manager
         self._timer = wm.event_timer_add(0.1, window=context.window)

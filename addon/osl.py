@@ -2,13 +2,14 @@
 signed ramp closures (``lut.render.fitting.fit_osl``), and whether a scene
 renders it.
 
-The shader (``shaders/paint_lut_ramps.osl``) is stored in the .blend as a
-text and compiled into the node (mode Internal), so a render farm needs no
-file beside the .blend.  Blender compiles a Script node's text itself when
-its script is set; the ``bpy`` module cannot (its OSL query module is not
-importable, and setting the script would only report that), so there the
-shader is compiled with Cycles' own compiler and the sockets are made from
-the compiled parameters.
+The shader (``shaders/paint_lut_ramps.osl``) is compiled into the node
+(mode Internal: the bytecode is stored in the .blend), so a render farm
+needs no file beside the .blend.  In Blender the source is also kept as a
+text of the .blend, and Blender compiles it and makes the sockets when the
+node's script is set; the ``bpy`` module cannot (its OSL query module is
+not importable, and setting the script would only report that), so there
+the shader is compiled with Cycles' own compiler and the sockets are made
+from the compiled parameters.
 
 Open Shading Language runs on the CPU and with OptiX only.  Where a scene
 renders with SVM (OSL off, or a GPU without OptiX) Cycles leaves a Script

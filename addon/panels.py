@@ -33,10 +33,19 @@ def draw_settings(layout, material, scene=None):
         layout.label(text="Paint type changed since the last bake", icon="ERROR")
     elif settings.lut_path:
         layout.label(text=bpy.path.basename(settings.lut_path), icon="CHECKMARK")
-        for target, fit in api.fit_errors(material).items():
+        errors = api.fit_errors(material, variants=True)
+        offer = errors.pop(api.OSL_VARIANT, None) if not settings.osl else None
+        for target, fit in errors.items():
             layout.label(text=fit_error_text(target, fit), icon="ERROR" if fit.missed else "CHECKMARK")
             if target == "EEVEE" and fit.eevee_mode:
                 layout.label(text=eevee_text(fit, api.eevee_mode(scene)), icon="INFO")
+        # Cycles' OSL variant: offered where the SVM fit misses its goals.
+        if settings.osl or (offer is not None and errors.get("CYCLES") is not None and errors["CYCLES"].missed):
+            layout.prop(settings, "osl")
+            if offer is not None:
+                layout.label(text=offer_text(offer), icon="INFO")
+            if scene is not None:
+                layout.label(text=variant_text(settings.osl, api.cycles_variant(material, scene)), icon="INFO")
     if scene is not None and getattr(scene, "paint_lut", None) is not None:
         layout.prop(scene.paint_lut, "eevee_mode", text="EEVEE (scene)")
 
@@ -54,6 +63,28 @@ def eevee_text(fit, scene_mode: str) -> str:
     return text
 
 
+def offer_text(fit) -> str:
+    """The panel's line offering Cycles' OSL variant (an ``api.FitError`` of it)."""
+    return (
+        f"With OSL, Cycles would render {100 * fit.error:.1f}% (target {100 * fit.target:.0f}%), "
+        f"grazing light {100 * fit.grazing:.1f}% (target {100 * fit.grazing_target:.0f}%)"
+    )
+
+
+def variant_text(asked: bool, drawn: str) -> str:
+    """The panel's line on what Cycles draws of the material in this scene
+    (``api.cycles_variant``)."""
+    if drawn == "OSL":
+        return "Cycles renders the OSL variant here"
+    if asked:
+        return "Cycles renders the SVM closures here: turn Open Shading Language on (CPU or OptiX) for the OSL variant"
+    return "Cycles renders the SVM closures; the OSL variant needs Open Shading Language (CPU or OptiX)"
+
+
+#: How the panel names each fit's engine.
+ENGINE_LABELS = {"CYCLES": "Cycles", "EEVEE": "EEVEE", "OSL": "Cycles OSL"}
+
+
 def seen_limit_text(limit: float) -> str:
     """The panel's note when "Color as Seen" is at its most (``seen_limit``)."""
     return f"Seen colour capped at {limit:.2f}: a white pigment shows no more through the binder"
@@ -62,8 +93,9 @@ def seen_limit_text(limit: float) -> str:
 def fit_error_text(target, fit) -> str:
     """The panel's line for an engine's ``api.FitError``: the fidelity
     measure over its whole grid and over the grazing band, with their goals."""
+    label = ENGINE_LABELS.get(target, target.title())
     return (
-        f"{target.title()} fit error {100 * fit.error:.1f}% (target {100 * fit.target:.0f}%), "
+        f"{label} fit error {100 * fit.error:.1f}% (target {100 * fit.target:.0f}%), "
         f"grazing light {100 * fit.grazing:.1f}% (target {100 * fit.grazing_target:.0f}%)"
     )
 

@@ -80,6 +80,20 @@ def _send_colours(settings):
         live.update_inputs(material)
 
 
+#: What a switch of a material's OSL setting calls, with the material
+#: (``addon.api.switch_variant`` adds itself: the API imports this module).
+OSL_SWITCHED = []
+
+
+def _osl_changed(self, context):
+    """The Cycles OSL variant was switched: a baked material is wired to the
+    variant's group (or back to the SVM one) at once (``OSL_SWITCHED``)."""
+    material = self.id_data
+    if isinstance(material, bpy.types.Material):
+        for switch in OSL_SWITCHED:
+            switch(material)
+
+
 def _preset_changed(self, context):
     before = self.type_key()
     if self.preset == "SPECTRAL":
@@ -170,6 +184,11 @@ def _set_seen(self, value):
 class PaintLUTSettings(bpy.types.PropertyGroup):
     enabled: bpy.props.BoolProperty(
         name="Use Paint LUT", default=False, description="Render this material as a Paint LUT paint",
+    )  # fmt: skip
+    osl: bpy.props.BoolProperty(
+        name="Cycles OSL Variant", default=False, update=_osl_changed,
+        description="In Cycles with Open Shading Language on (CPU, OptiX), add signed ramp closures that follow "
+        "the paint closer at grazing light and on dark rough paints; other scenes render the SVM closures",
     )  # fmt: skip
     preset: bpy.props.EnumProperty(
         name="Preset", items=_preset_items, default=0, update=_preset_changed,

@@ -124,7 +124,7 @@ def build_wheel(directory: pathlib.Path) -> pathlib.Path:
 
 
 def stage(directory: pathlib.Path) -> pathlib.Path:
-    """The extension's source folder: add-on modules, asset library, manifest and wheel."""
+    """The extension's source folder: add-on modules, asset library, OSL shader, manifest and wheel."""
     source = directory / "paint_lut"
     (source / "wheels").mkdir(parents=True)
     for module in sorted((ROOT / "addon").glob("*.py")):
@@ -134,6 +134,10 @@ def stage(directory: pathlib.Path) -> pathlib.Path:
     (source / "assets").mkdir()
     for name in ASSETS:
         shutil.copy2(assets / name, source / "assets" / name)
+    # The OSL variant's shader source (addon/osl.py compiles it).
+    (source / "shaders").mkdir()
+    for shader in sorted((ROOT / "addon" / "shaders").glob("*.osl")):
+        shutil.copy2(shader, source / "shaders" / shader.name)
     shutil.copy2(ROOT / "blender_manifest.toml", source / "blender_manifest.toml")
     build_wheel(source / "wheels")
     return source
@@ -185,6 +189,7 @@ def untracked(root: pathlib.Path = ROOT) -> list[str]:
         if (name.startswith("lut/") and name.endswith(".py"))
         or (name.startswith("addon/") and name.count("/") == 1 and name.endswith(".py"))
         or name in packed
+        or (name.startswith("addon/shaders/") and name.endswith(".osl"))
     ]
 
 

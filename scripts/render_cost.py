@@ -2,6 +2,7 @@
 
     .venv/bin/python scripts/render_cost.py [--samples N] [--size PX] [--engine CYCLES|EEVEE]
     .venv/bin/python scripts/render_cost.py --per-kind
+    .venv/bin/python scripts/render_cost.py --osl [--random 2 5]
 
 Renders a UV sphere lit by a Sun and a dim world at 256x256
 (addon.scenes.sphere_scene), once with a Principled BSDF and once with each
@@ -12,7 +13,11 @@ warm-up) and the closures of its fit.
 ``--per-kind`` measures those costs: for each closure kind, the add-on's
 node group of one closure and of ``PER_KIND_COUNT`` of them (a rough
 type's fit with its closures replaced), the difference per closure in
-Principled BSDFs."""
+Principled BSDFs.
+
+``--osl`` also times Cycles' OSL variant of each paint (its material's
+setting on, Open Shading Language on, CPU) against the same material's SVM
+group rendered by SVM and against a Principled BSDF rendered by OSL."""
 
 from __future__ import annotations
 
@@ -99,7 +104,10 @@ def main(argv=None):
         "--random", type=int, nargs="*", default=[], help="also these paints of lut.bench.random_paints, by index"
     )
     parser.add_argument("--per-kind", action="store_true", help="instead: the render cost of each closure kind")
+    parser.add_argument("--osl", action="store_true", help="also Cycles' OSL variant of each paint")
     args = parser.parse_args(argv)
+    if args.osl and args.engine != "CYCLES":
+        parser.error("--osl needs --engine CYCLES")
     addon.register()
     engine = "CYCLES" if args.engine == "CYCLES" else scenes.EEVEE
     sc, sphere = scenes.sphere_scene(args.size, args.samples, engine)
@@ -107,6 +115,11 @@ def main(argv=None):
     sphere.data.materials.append(principled)
     base = timed(sc)
     print(f"Principled BSDF: {base:.3f} s ({args.engine}, {args.size}x{args.size}, {args.samples} samples)")
+    if args.osl:
+        sc.cycles.shading_system = True
+        base_osl = timed(sc)
+        sc.cycles.shading_system = False
+        print(f"Principled BSDF with OSL: {base_osl:.3f} s")
     if args.per_kind:
         per_kind(sc, sphere, base, pathlib.Path(tempfile.mkdtemp()))
         return
@@ -123,6 +136,16 @@ def main(argv=None):
         )  # what api.new_material baked
         counted = sum(c.cost for c in cached.fits[args.engine].closures)
         print(f"{name:28} {t:.3f} s  ratio {t / base:.2f}  ({counted} closures)")
+        if args.osl:
+            material.paint_lut.osl = True  # the variant's group, from the cached bake
+            sc.cycles.shading_system = True
+            t_osl = timed(sc)
+            sc.cycles.shading_system = False
+            material.paint_lut.osl = False
+            print(
+                f"{name + ' (OSL variant)':28} {t_osl:.3f} s  ratio {t_osl / base:.2f} to Principled (SVM), "
+                f"{t_osl / base_osl:.2f} to Principled (OSL), {t_osl / t:.2f} to its SVM group"
+            )
 
 
 if __name__ == "__main__":

@@ -59,7 +59,7 @@ def test_defaults_are_the_paint_defaults(material):
 
 #: The material settings that are not paint fields.
 NOT_PAINT_FIELDS = {"rna_type", "name", "enabled", "preset", "lut_path", "stale", "internal_reflectance",
-                    "diffuse_albedo", "seen", "fits", "spectral_paint"}  # fmt: skip
+                    "diffuse_albedo", "seen", "fits", "spectral_paint", "osl"}  # fmt: skip
 
 
 def _float32(value):
@@ -310,7 +310,11 @@ def test_bake_wires_a_group_per_engine_with_colour_inputs(material, lut_dir):
     calibrated = "".join(map(str, api.eevee_calibration()))  # EEVEE fitted with this Blender's measured closures
     calibrated += "c"  # in the scene's default mode, Converged
     version = f"f{fitting.FIT_VERSION}"  # in the name: an older release's files are never overwritten
-    assert names == [f"paintfit-cycles-{version}", f"paintfit-eevee{calibrated}-{version}", "paintlut"]
+    # Cycles' OSL variant is baked beside its SVM fit (a material switches to it without a bake).
+    assert names == [
+        f"paintfit-cycles-{version}", f"paintfit-cyclesosl-{version}", f"paintfit-eevee{calibrated}-{version}",
+        "paintlut",
+    ]  # fmt: skip
     # A texture driving the pigment survives a rebake; still two outputs and two group nodes.
     texture = tree.nodes.new("ShaderNodeTexImage")
     tree.links.new(texture.outputs["Color"], _group_node(material).inputs["Pigment Color"])
@@ -449,7 +453,7 @@ def test_saved_files_reference_luts_relatively(fresh_file, tmp_path):
     assert image.filepath.startswith("//paint_lut/paintfit-")
     assert (tmp_path / "paint_lut").is_dir()
     assert "UNDO" in operators.PAINTLUT_OT_bake.bl_options
-    assert json.loads(material.paint_lut.fits).keys() == {"CYCLES", "EEVEE"}
+    assert json.loads(material.paint_lut.fits).keys() == {"CYCLES", "EEVEE", "OSL"}  # OSL: Cycles' OSL variant
 
 
 def test_save_as_elsewhere_rebakes_what_points_at_the_old_folder(fresh_file, tmp_path):
@@ -747,3 +751,42 @@ def test_the_scenes_eevee_mode_picks_the_eevee_fit_and_the_panel_and_report_say_
     }  # fmt: skip
     assert "mode" not in entry["CYCLES"]
     assert api.is_current(material, api.paint_of(material), directory=lut_dir)
+
+
+def test_the_osl_setting_switches_the_cycles_group_without_a_bake(material, lut_dir):
+    """Off by default.  Switched on, a baked material's Cycles group becomes
+    the OSL variant's (its SVM closures and one Script node of ramps) from
+    the cached bake; the material is current, its errors name the variant,
+    and the panel says what a scene without OSL draws.  Switched off, the SVM
+    group is back."""
+    from addon import api, nodes, panels
+
+    api.set_paint(material, lut.Paint(rho=(0.02, 0.03, 0.02), slope=1.5, distribution="gaussian"))
+    api.bake_material(material, directory=lut_dir, **SMALL)
+    assert not material.paint_lut.osl and api.OSL_VARIANT not in api.fit_errors(material)
+    svm = nodes.group_of(material, "CYCLES").node_tree
+    assert not any(nd.type == "SCRIPT" for nd in svm.nodes)
+    errors = api.fit_errors(material, variants=True)
+    assert errors["CYCLES"].missed and errors[api.OSL_VARIANT].error < errors["CYCLES"].error
+    layout = _Layout()
+    panels.draw_settings(layout, material, bpy.context.scene)
+    assert "osl" in layout.props  # offered: the SVM fit misses its goals
+    assert any(t.startswith("With OSL, Cycles would render") for t, _ in layout.labels)
+
+    material.paint_lut.osl = True  # rewired at once from the cached bake
+    group = nodes.group_of(material, "CYCLES").node_tree
+    scripts = [nd for nd in group.nodes if nd.type == "SCRIPT"]
+    assert len(scripts) == 1 and scripts[0].bytecode and scripts[0].outputs["Ramps"].is_linked
+    assert api.is_current(material, api.paint_of(material), directory=lut_dir, **SMALL)
+    assert api.OSL_VARIANT in api.fit_errors(material)
+    bpy.context.scene.render.engine = "CYCLES"
+    bpy.context.scene.cycles.shading_system = False
+    assert api.cycles_variant(material, bpy.context.scene) == "SVM"
+    layout = _Layout()
+    panels.draw_settings(layout, material, bpy.context.scene)
+    assert any(t.startswith("Cycles renders the SVM closures here") for t, _ in layout.labels)
+    bpy.context.scene.cycles.shading_system = True
+    assert api.cycles_variant(material, bpy.context.scene) == "OSL"
+
+    material.paint_lut.osl = False
+    assert nodes.group_of(material, "CYCLES").node_tree == svm

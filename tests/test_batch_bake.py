@@ -79,7 +79,7 @@ def test_bake_cache_edit_and_corruption(tmp_path):
     key = luts[0].stem.removeprefix("paintlut-")
     assert entry["shared"] == {key: ["blue", "red"]}
     computed = sorted(entry["materials"][name]["computed"] for name in ("red", "blue"))
-    assert computed == [[], ["lut", "CYCLES", "EEVEE"]]  # the second found the first's bake
+    assert computed == [[], ["lut", "CYCLES", "EEVEE", "OSL"]]  # the second found the first's bake
     assert set(entry["materials"]["blue"]["fit"]) == {"CYCLES", "EEVEE"}
     for engine, fit in entry["materials"]["blue"]["fit"].items():  # the measure, whole and over the grazing band
         drawn = {"mode", "exact_at_one_sample", "samples"} if engine == "EEVEE" else set()  # how EEVEE draws it
