@@ -28,7 +28,7 @@ def main(argv=None) -> int:
     args = parser.parse_args(argv)
     paints = [(name, lut.preset(name)) for name in lut.PRESETS] + bench.random_paints(args.random)
     print(f"threads per bake: {table.default_workers()}")
-    print("| paint | LUT | fits (Cycles + EEVEE) | total, cold | another colour (cached) |")
+    print("| paint | LUT | fits (Cycles, its OSL variant, EEVEE) | total, cold | another colour (cached) |")
     print("|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as tmp:
         for label, lut_s, fit_s, total, cached in bench.render_bake_times(paints, tmp, args.repeat):
