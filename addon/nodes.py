@@ -168,15 +168,14 @@ def build_group(fit: fitting.Fit, weights_path, exact_metallic=None):
     u = _view_lookup(tree, links, lay, len(fit.cos_view))
     amps = _amplitudes(tree, links, lay, inputs, fit.internal_reflectance)
     image = _image(weights_path)
-    rows = fitting.texels(fit.closures, fit.rows)
+    rows = fitting.texels(fit.closures, fit.rows, fit.weights.shape[3])
     textures, ramps = {}, {}
-    for r, (k, c) in enumerate(rows):
+    for r, slots in enumerate(rows):
         coord = lay.place(tree.nodes.new("ShaderNodeCombineXYZ"), "weights", "Weights per view")
         links.new(u, coord.inputs["X"])
         coord.inputs["Y"].default_value = (r + 0.5) / len(rows)
-        ramp = isinstance(k, tuple)  # three knots of an OSL ramp, in R, G, B
-        first = next(j for j in k if j is not None) if ramp else k
-        coord.label = f"{fit.closures[first].kind} {fitting.COMPONENTS[c]}"
+        live = [slot for slot in slots if slot is not None]
+        coord.label = ", ".join(f"{fit.closures[k].kind} {fitting.COMPONENTS[c]}" for k, c in dict.fromkeys(live))
         tex = lay.place(tree.nodes.new("ShaderNodeTexImage"), "weights", "Weights per view")
         tex.image = image
         # Closest: the texture's columns are dense (fitting.TEXTURE_VIEWS);
@@ -184,10 +183,17 @@ def build_group(fit: fitting.Fit, weights_path, exact_metallic=None):
         tex.interpolation = "Closest"
         tex.extension = "EXTEND"
         links.new(coord.outputs[0], tex.inputs["Vector"])
-        if ramp:
-            ramps[(first, c)] = tex.outputs["Color"]
-        else:
-            textures[(k, c)] = tex.outputs["Color"]
+        first = live[0]
+        if fit.closures[first[0]].osl:  # three knots of an OSL ramp, in R, G, B
+            ramps[first] = tex.outputs["Color"]
+        elif all(slot == first for slot in slots):  # one row, a weight per channel
+            textures[first] = tex.outputs["Color"]
+        else:  # three rows, one per channel
+            split = lay.place(tree.nodes.new("ShaderNodeSeparateColor"), "weights", "Weights per view")
+            links.new(tex.outputs["Color"], split.inputs["Color"])
+            for channel, slot in enumerate(slots):
+                if slot is not None:
+                    textures[slot] = split.outputs[channel]
     total = None
     for k, closure in enumerate(fit.closures):
         rows_k = [(c, textures[(k, c)]) for c in range(len(fitting.COMPONENTS)) if (k, c) in textures]

@@ -1,6 +1,7 @@
 """lut.render.closures, lut.render.nnls and lut.render.fitting: closure kinds, non-negative least
 squares, and the fit of a paint type's LUT (numpy side)."""
 
+import dataclasses
 import functools
 
 import numpy as np
@@ -349,6 +350,23 @@ def test_weights_file_round_trip_and_tampering(luts, tmp_path):
     path.write_bytes(bytes(data))
     with pytest.raises(lutfile.LUTError):
         fitting.read_fit(path)
+
+
+def test_weights_texture_packs_three_rows_a_texel_and_a_channel_each_when_dispersive(luts, tmp_path):
+    """A fit with one weight per view puts three weight rows in each texel
+    (R, G, B: a node group reads them with one lookup); one with a weight
+    per channel (a dispersive type) keeps a texel per row, channel t holding
+    tile t.  Both read back exactly."""
+    fitted = fitting.fit_lut(luts["dark satin"], "CYCLES")
+    layout = fitting.texels(fitted.closures, fitted.rows)
+    assert len(fitted.rows) > 3 and len(layout) == -(-len(fitted.rows) // 3)
+    assert [slot for slots in layout for slot in slots if slot] == fitted.rows
+    scale = np.array([0.5, 1.0, 2.0])  # a different weight per channel
+    dispersive = dataclasses.replace(fitted, weights=fitted.weights * scale)
+    assert fitting.texels(dispersive.closures, dispersive.rows, 3) == [(row,) * 3 for row in fitted.rows]
+    for fit in (fitted, dispersive):
+        back = fitting.read_fit(fitting.write_fit(fit, tmp_path / f"w{fit.weights.shape[3]}.exr"))
+        np.testing.assert_allclose(back.weights, fit.weights, rtol=1e-6, atol=1e-9)
 
 
 def test_randomised_types_fit_within_their_targets():

@@ -87,16 +87,17 @@ def test_the_ramps_lower_the_measure_on_paints_nobody_tuned_for(bakes):
 def test_the_variants_file_packs_three_knots_a_texel_and_reads_back(bakes, tmp_path):
     """A ramp's eight knots take three texels per component (R, G, B), the
     file reads back the weights it was written with, and a bake finds it
-    cached; the SVM fit's own file keeps one row per weight row."""
+    cached; the SVM rows take a texel per three rows, in both files."""
     paint, result = next(iter(bakes.values()))
     variant = result.osl
     layout = fitting.texels(variant.closures, variant.rows)
-    packed = [entry for entry in layout if isinstance(entry[0], tuple)]
+    packed = [slots for slots in layout if variant.closures[next(s for s in slots if s)[0]].osl]
     ramp_rows = [r for r in variant.rows if variant.closures[r[0]].osl]
     families = {(variant.closures[k].kind, variant.closures[k].exponent) for k, _ in ramp_rows}
-    assert ramp_rows and sum(k is not None for trio, _ in packed for k in trio) == len(ramp_rows)
+    assert ramp_rows and sum(slot is not None for slots in packed for slot in slots) == len(ramp_rows)
+    assert all(len({c for _, c in filter(None, slots)}) == 1 for slots in packed)  # one component a texel
     assert len(packed) <= 3 * len(fitting.COMPONENTS) * len(families)
-    assert len(layout) == len(variant.rows) - len(ramp_rows) + len(packed)
+    assert len(layout) == -(-(len(variant.rows) - len(ramp_rows)) // 3) + len(packed)
     back = fitting.read_fit(result.osl_path)
     np.testing.assert_allclose(back.weights, variant.weights, atol=1e-5 * np.abs(variant.weights).max())
     assert back.closures == variant.closures and back.osl
@@ -104,7 +105,8 @@ def test_the_variants_file_packs_three_knots_a_texel_and_reads_back(bakes, tmp_p
     again = render_bake.bake_for_render(paint, result.lut_path.parent, targets=("CYCLES",), osl=True)
     assert again.computed == []
     svm = result.fits["CYCLES"]
-    assert fitting.texels(svm.closures, svm.rows) == [tuple(r) for r in svm.rows]
+    flat = [slot for slots in fitting.texels(svm.closures, svm.rows) for slot in slots if slot is not None]
+    assert flat == [tuple(r) for r in svm.rows]
 
 
 def test_the_variant_needs_cycles_and_an_svm_base(bakes):

@@ -68,7 +68,7 @@ from .nnls import nnls_gram_batch, solve_spd
 #: Fit format version: bumped when the weights file layout or the fit changes.
 #: It is part of the weights file's name (``fit_path``), so a new release
 #: never overwrites a file that an older release's node groups still read.
-FIT_VERSION = 9
+FIT_VERSION = 10
 
 #: Goals of the fidelity measure (whole domain) per engine and kind of
 #: paint (``lut.render.measure.GOALS``; the grazing band's are twice these).
@@ -1030,17 +1030,30 @@ def fit_path(
     return lut_path.with_name(lut_path.name.replace("paintlut-", f"paintfit-{name}-f{FIT_VERSION}-"))
 
 
-def texels(basis, rows) -> list:
+def texels(basis, rows, tiles=1) -> list:
     """The rows of a fit's weights texture, bottom to top, for closures
-    ``basis`` with weight rows ``rows`` (``Fit.rows``): ``(k, c)`` for an SVM
-    closure's row (its weight in all three channels, as a colour node reads
-    it), then for each OSL ramp (its knots, ``closures.ramp_closures``) and
-    component ``((k0, k1, k2), c)``: three knots' weights side by side in R,
-    G and B (None where a knot has none), so a ramp's eight knots take three
-    texture lookups, not eight.  A fit without ramps has one row per ``rows``
-    entry, as before."""
+    ``basis`` with weight rows ``rows`` (``Fit.rows``) and ``tiles`` weights
+    per view (``Fit.weights.shape[3]``).  Each texture row is a triple of
+    slots, what its R, G and B channels hold: ``(k, c)`` (the weights of
+    closure k, component c) or None.
+
+    * One weight per view (``tiles`` 1): three SVM rows share a texture row,
+      one per channel, so a node group reads them with one lookup (an image
+      lookup costs about as much render time as a closure: a twelve-closure
+      group's 33 rows took a third of its time).  Rows are taken in order.
+    * One weight per channel (a dispersive type, ``tiles`` 3): each SVM row
+      has a texture row of its own, ``((k, c),) * 3``, channel t holding
+      tile t.
+    * Each OSL ramp (its knots, ``closures.ramp_closures``) and component:
+      three knots of the same ramp side by side, ``((k0, c), (k1, c),
+      (k2, c))``, the Script node reading the whole colour, so a ramp's
+      eight knots take three lookups."""
     used = set(map(tuple, rows))
-    out = [(k, c) for k, c in map(tuple, rows) if not basis[k].osl]
+    svm = [(k, c) for k, c in map(tuple, rows) if not basis[k].osl]
+    if tiles > 1:
+        out = [(row,) * 3 for row in svm]
+    else:
+        out = [_triple(svm[start : start + 3]) for start in range(0, len(svm), 3)]
     families = {}
     for k, closure in enumerate(basis):
         if closure.osl:
@@ -1048,23 +1061,25 @@ def texels(basis, rows) -> list:
     for knots in families.values():
         for c in range(len(COMPONENTS)):
             for start in range(0, len(knots), 3):
-                trio = tuple(k if (k, c) in used else None for k in knots[start : start + 3])
-                trio += (None,) * (3 - len(trio))
-                if any(k is not None for k in trio):
-                    out.append((trio, c))
+                triple = _triple([(k, c) if (k, c) in used else None for k in knots[start : start + 3]])
+                if any(slot is not None for slot in triple):
+                    out.append(triple)
     return out
 
 
+def _triple(slots) -> tuple:
+    slots = tuple(slots)
+    return slots + (None,) * (3 - len(slots))
+
+
 def _image(fitted: Fit) -> np.ndarray:
-    layout = texels(fitted.closures, fitted.rows)
+    tiles = fitted.weights.shape[3]
+    layout = texels(fitted.closures, fitted.rows, tiles)
     image = np.zeros((max(len(layout), 1), len(fitted.cos_view), 3), dtype=np.float32)
-    for r, (k, c) in enumerate(layout):
-        if isinstance(k, tuple):
-            for channel, knot in enumerate(k):
-                if knot is not None:
-                    image[r, :, channel] = fitted.weights[knot, c, :, 0]
-        else:
-            image[r] = np.broadcast_to(fitted.weights[k, c], (len(fitted.cos_view), 3))
+    for r, slots in enumerate(layout):
+        for channel, slot in enumerate(slots):
+            if slot is not None:
+                image[r, :, channel] = fitted.weights[slot[0], slot[1], :, channel if tiles > 1 else 0]
     return image[::-1]  # EXR rows run top to bottom
 
 
@@ -1076,9 +1091,10 @@ def _hash(header_json: str, image: np.ndarray) -> str:
 
 def write_fit(fitted: Fit, path) -> pathlib.Path:
     """Write a fit's weights texture and header atomically: row r (counted
-    from the bottom, where a Blender image has v = 0) holds the weights of
-    ``rows[r]`` at the view cosines; the header (JSON) and a content hash
-    let ``read_fit`` rebuild and verify it."""
+    from the bottom, where a Blender image has v = 0) holds at the view
+    cosines the weights of the slots of ``texels(...)[r]`` in its R, G and
+    B channels; the header (JSON) and a content hash let ``read_fit``
+    rebuild and verify it."""
     image = _image(fitted)
     header_json = lutfile.canonical_json(fitted.header())
     return lutfile.write_exr(path, image, {"paintfit:header": header_json, "paintfit:hash": _hash(header_json, image)})
@@ -1098,13 +1114,10 @@ def read_fit(path) -> Fit:
         basis = [Closure(**c) for c in h["closures"]]
         views, tiles = int(h["views"]), int(h["tiles"])
         weights = np.zeros((len(basis), len(COMPONENTS), views, tiles))
-        for r, (k, c) in enumerate(texels(basis, h["rows"])):
-            if isinstance(k, tuple):  # an OSL ramp's knots, one per channel (one tile)
-                for channel, knot in enumerate(k):
-                    if knot is not None:
-                        weights[knot, c, :, 0] = pixels[::-1][r, :, channel]
-            else:
-                weights[k, c] = pixels[::-1][r, :, :tiles]
+        for r, slots in enumerate(texels(basis, h["rows"], tiles)):
+            for channel, slot in enumerate(slots):
+                if slot is not None:
+                    weights[slot[0], slot[1], :, channel if tiles > 1 else 0] = pixels[::-1][r, :, channel]
         return Fit(
             target=h["target"],
             exact_metallic=bool(h["exact_metallic"]),
