@@ -72,6 +72,8 @@ def unit_or(v: np.ndarray, fallback: np.ndarray) -> tuple[np.ndarray, np.ndarray
     Returns (unit vectors, norms)."""
     norm = np.sqrt(dot(v, v))
     ok = norm > PARALLEL_EPS
+    if ok.all():  # the usual case: no fallback to merge in (the same values, half the array work)
+        return v / norm[..., None], norm
     safe = np.where(ok, norm, 1.0)
     out = np.where(ok[..., None], v / safe[..., None], fallback)
     return out, norm

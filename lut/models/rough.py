@@ -49,8 +49,11 @@ The paper's random-pairs average itself is kept, as a check only, in
 
 from __future__ import annotations
 
+import concurrent.futures
 import dataclasses
 import functools
+import os
+import threading
 
 import numpy as np
 
@@ -221,12 +224,29 @@ def rough_internal_reflectance(n: float, slope: float, distribution: str, nodes=
     return float(1.0 - 2.0 * integral / (n * n))
 
 
-@functools.lru_cache(maxsize=16)
+#: Held while a transmittance row table is made: threads evaluating one
+#: paint type at once (a LUT bake's chunks) wait for the first one's table
+#: instead of each making it again.
+_ROW_TABLE_LOCK = threading.Lock()
+
+
 def _row_table(n, slope, distribution, nodes, size):
     """The transmittance rows on a uniform grid of ``size`` polar angles over
-    [0, π/2], cached per interface (read-only arrays)."""
+    [0, π/2], cached per interface (read-only arrays), made once whichever
+    thread asks first."""
+    with _ROW_TABLE_LOCK:
+        return _row_table_cached(n, slope, distribution, nodes, size)
+
+
+@functools.lru_cache(maxsize=16)
+def _row_table_cached(n, slope, distribution, nodes, size):
     grid = np.linspace(0.0, np.pi / 2, size)
-    table = _transmittance_rows(grid, n, slope, distribution, nodes)
+    # The angles are independent (numpy releases the interpreter lock in
+    # the facet arithmetic): split over the cores, at most four.
+    parts = np.array_split(grid, max(1, min(4, os.cpu_count() or 1, size)))
+    with concurrent.futures.ThreadPoolExecutor(max_workers=len(parts), thread_name_prefix="paint-lut-rows") as pool:
+        rows = list(pool.map(lambda part: _transmittance_rows(part, n, slope, distribution, nodes), parts))
+    table = np.concatenate(rows, axis=0)
     grid.setflags(write=False)
     table.setflags(write=False)
     return grid, table
