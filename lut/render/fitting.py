@@ -1038,9 +1038,9 @@ def texels(basis, rows, tiles=1) -> list:
     closure k, component c) or None.
 
     * One weight per view (``tiles`` 1): three SVM rows share a texture row,
-      one per channel, so a node group reads them with one lookup (an image
-      lookup costs about as much render time as a closure: a twelve-closure
-      group's 33 rows took a third of its time).  Rows are taken in order.
+      one per channel, so a node group reads them with one lookup (a
+      twelve-closure group: 11 lookups instead of 33, its Cycles render
+      5-10% faster, measured back to back).  Rows are taken in order.
     * One weight per channel (a dispersive type, ``tiles`` 3): each SVM row
       has a texture row of its own, ``((k, c),) * 3``, channel t holding
       tile t.
