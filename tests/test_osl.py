@@ -2,6 +2,8 @@
 formulas, the signed fit's bound, its gain on paints nobody tuned for, and
 its weights file.  Numpy only; the renders are in test_osl_render.py."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -46,39 +48,54 @@ def test_ramp_knots_are_the_ramps_of_cycles_osl():
 
 def test_the_variant_keeps_the_svm_closures_and_never_renders_negative(bakes):
     """The variant's SVM closures and weights are the SVM fit's (a scene
-    without OSL renders exactly the SVM fit), and for random colours of each
-    type its radiance is nowhere negative beyond the measure's grid: lights
-    to 89°, every view to 80°, every azimuth."""
+    without OSL renders exactly the SVM fit), and for each component alone
+    and for random colours of each type its radiance is nowhere negative:
+    lights to 89.99° (a diffuse ramp keeps its first knot at the horizon,
+    where the SVM closures fade), views to 89° between the texture's
+    columns, every azimuth, on a grid off the one the bound is fitted on;
+    each point against the SVM radiance at that same point (the
+    bound's margin, ``fitting.OSL_MARGIN``, covers the points between)."""
     rng = np.random.default_rng(5)
-    tl, tv, ph = np.meshgrid(np.radians(np.arange(0, 90, 2.0)), np.radians(np.arange(0, 81, 5.0)),
-                             np.radians(np.arange(0, 181, 10.0)), indexing="ij")  # fmt: skip
+    tl, tv, ph = (a.ravel() for a in np.meshgrid(
+        np.radians(np.r_[np.arange(0.0, 89.0, 1.7), 88.6, 89.3, 89.9, 89.99]),
+        np.radians(np.r_[np.arange(0.0, 89.0, 2.9), 89.0]),
+        np.radians(np.arange(0.0, 181.0, 7.0)), indexing="ij"))  # fmt: skip
     for label, (_paint, result) in bakes.items():
         svm, variant = result.fits["CYCLES"], result.osl
         k = len(svm.closures)
         assert variant.closures[:k] == svm.closures
         np.testing.assert_allclose(variant.weights[:k], svm.weights, atol=1e-5 * np.abs(svm.weights).max())
         assert variant.osl and all(c.osl for c in variant.closures[k:])
-        for _ in range(4):
-            amps = rng.uniform(0.0, 1.0, (3, 3))
-            radiance = variant.radiance(amps, tl.ravel(), tv.ravel(), ph.ravel())
-            scale = np.abs(svm.radiance(amps, tl.ravel(), tv.ravel(), ph.ravel())).max()
-            assert radiance.min() >= -1e-4 * scale, (label, radiance.min(), scale)
+        colours = [np.eye(3)[:, [c] * 3].T for c in range(3)] + [rng.uniform(0.0, 1.0, (3, 3)) for _ in range(3)]
+        for amps in colours:
+            radiance = variant.radiance(amps, tl, tv, ph)
+            local = svm.radiance(amps, tl, tv, ph)
+            floor = -1e-3 * local - 1e-9 * local.max()  # rounding where both underflow
+            worst = np.argmin(radiance - floor)
+            assert np.all(radiance >= floor), (label, radiance.flat[worst], local.flat[worst])
 
 
 def test_the_ramps_lower_the_measure_on_paints_nobody_tuned_for(bakes):
-    """Reported on the measure (whole and grazing band), the variant is never
-    further from its goals than the SVM fit, and on most rough paints of the
-    set it is nearer the paint: the median of the whole figure falls by a
-    tenth at least."""
+    """The variant keeps its ramps only where they bring the type nearer its
+    goals (``fitting.shortfall``: its worst component's error over its goal,
+    whole and grazing band), so its shortfall is never above the SVM fit's;
+    for each paint's own colour it is at most 0.2% (absolute) worse on
+    either figure, and on most rough paints of the set it is nearer the
+    paint: the median of the whole figure falls by a tenth at least."""
     gains = []
     for label, (paint, result) in bakes.items():
+        svm_fit, osl_fit = result.fits["CYCLES"], result.osl
+        goals = measure.goals("OSL", paint.slope == 0)
+
+        def short(fit, goals=goals):
+            return fitting.shortfall(
+                (fit.residual, fit.reference), (fit.grazing_residual, fit.grazing_reference), goals
+            )
+
+        assert short(osl_fit) <= short(svm_fit) + 1e-9, (label, short(svm_fit), short(osl_fit))
         errors = result.all_errors(paint)
         svm, osl = errors["CYCLES"], errors[render_bake.OSL_VARIANT]
-        goals = measure.goals("OSL", paint.slope == 0)
-        assert (
-            max(o / g for o, g in zip(osl, goals, strict=True))
-            <= max(s / g for s, g in zip(svm, goals, strict=True)) + 1e-9
-        ), (label, svm, osl)
+        assert all(o <= s + 0.002 for o, s in zip(osl, svm, strict=True)), (label, svm, osl)
         if paint.slope > 0:
             gains.append(osl[0] / svm[0])
     assert np.median(gains) < 0.9, gains
@@ -135,3 +152,27 @@ def test_the_variants_radiance_is_what_its_reported_error_measures(bakes):
         reported = result.all_errors(paint)[render_bake.OSL_VARIANT]
         for got, promised in zip(measured, reported, strict=True):
             assert abs(got - promised) <= 0.002, (label, measured, reported)
+
+
+def test_a_cached_variant_is_made_again_when_its_svm_fit_changed(tmp_path):
+    """A variant's file names the SVM fit it was made from (its content key,
+    the same for a fit and its file read back): a Cycles fit written anew
+    under the same name (another release's fit, a file restored from
+    elsewhere) makes the next bake fit the variant again, from that fit."""
+    _label, paint = SET[1]
+    first = render_bake.bake_for_render(paint, tmp_path, targets=("CYCLES",), osl=True)
+    svm = first.fits["CYCLES"]
+    assert (
+        first.osl.base_key
+        == fitting.content_key(svm)
+        == fitting.content_key(fitting.read_fit(first.fit_paths["CYCLES"]))
+    )
+    other = dataclasses.replace(svm, weights=svm.weights * 0.9)  # a valid fit of the same LUT, other weights
+    fitting.write_fit(other, first.fit_paths["CYCLES"])
+    again = render_bake.bake_for_render(paint, tmp_path, targets=("CYCLES",), osl=True)
+    assert again.computed == [render_bake.OSL_VARIANT]
+    assert again.osl.base_key == fitting.content_key(other) != first.osl.base_key
+    k = len(other.closures)
+    np.testing.assert_allclose(again.osl.weights[:k], other.weights, atol=1e-5 * np.abs(other.weights).max())
+    loaded = render_bake.load_baked(again.lut_path, targets=("CYCLES",), osl=True)
+    assert loaded.computed == [] and loaded.osl.base_key == again.osl.base_key

@@ -56,6 +56,12 @@ class RenderBake:
         the grazing band, θl >= 60° (``Fit.grazing_error``)}."""
         return {target: band for target, (_, band) in self.all_errors(paint).items()}
 
+    @property
+    def drawn_osl(self) -> fitting.Fit | None:
+        """The OSL variant where its ramps carry weight (``Fit.draws_ramps``),
+        else None: a variant whose ramps did not pay renders as the SVM fit."""
+        return self.osl if self.osl is not None and self.osl.draws_ramps else None
+
     def variants(self) -> dict:
         """{name: fit}: each target's fit, and Cycles' OSL variant as "OSL"
         where it was baked (``OSL_VARIANT``)."""
@@ -69,9 +75,10 @@ class RenderBake:
         return {target: fitting.reported_errors(fit.grams(), amps) for target, fit in self.variants().items()}
 
 
-def _cached_fit(path, lut, target, exact_metallic, calibration, eevee_mode="EXACT", osl=False):
+def _cached_fit(path, lut, target, exact_metallic, calibration, eevee_mode="EXACT", osl=False, base=None):
     """The fit stored at ``path`` if it is valid and belongs to this LUT,
-    target, calibration, EEVEE mode and variant (SVM or OSL), else None."""
+    target, calibration, EEVEE mode and variant (SVM or OSL; an OSL
+    variant to the SVM fit ``base`` it is made from), else None."""
     if not pathlib.Path(path).exists():
         return None
     try:
@@ -81,6 +88,8 @@ def _cached_fit(path, lut, target, exact_metallic, calibration, eevee_mode="EXAC
     if fitted.lut_key != lut.key or fitted.target != target or fitted.exact_metallic != exact_metallic:
         return None
     if fitted.calibration != calibration or fitted.eevee_mode != eevee_mode or fitted.osl != osl:
+        return None
+    if base is not None and fitted.base_key != fitting.content_key(base):
         return None
     return fitted
 
@@ -159,8 +168,9 @@ def bake_for_render(
     variant = variant_path = None
     if osl:
         variant_path = fitting.fit_path(path, "CYCLES", exact_metallic, osl=True)
-        fresh = force or "CYCLES" in computed  # the variant is made from this Cycles fit
-        variant = None if fresh else _cached_fit(variant_path, table, "CYCLES", exact_metallic, None, osl=True)
+        variant = None if force else _cached_fit(
+            variant_path, table, "CYCLES", exact_metallic, None, osl=True, base=fits["CYCLES"]
+        )  # fmt: skip
         if variant is None:
             variant = fitting.fit_osl(table, fits["CYCLES"])
             fitting.write_fit(variant, variant_path)
@@ -177,7 +187,7 @@ def load_baked(
     """The ``RenderBake`` of a LUT already baked at ``lut_path`` and its
     targets' fits (the options as for ``bake_for_render``), from their
     files; Cycles' OSL variant (``osl``) is made from the Cycles fit where
-    it has no valid file yet (a tenth of a second).  Raises lut.LUTError
+    it has no valid file of that fit yet (about 0.3 s).  Raises lut.LUTError
     where the LUT or a fit is missing, damaged or of another bake."""
     path = pathlib.Path(lut_path)
     targets = [closures.validate_target(t) for t in targets]
@@ -194,7 +204,7 @@ def load_baked(
     variant = variant_path = None
     if osl and "CYCLES" in fits:
         variant_path = fitting.fit_path(path, "CYCLES", exact_metallic, osl=True)
-        variant = _cached_fit(variant_path, table, "CYCLES", exact_metallic, None, osl=True)
+        variant = _cached_fit(variant_path, table, "CYCLES", exact_metallic, None, osl=True, base=fits["CYCLES"])
         if variant is None:
             variant = fitting.fit_osl(table, fits["CYCLES"])
             fitting.write_fit(variant, variant_path)

@@ -318,22 +318,49 @@ def ramp_hat(position, knot):
     return np.maximum(0.0, 1.0 - np.abs(x - knot))
 
 
-def _diffuse_ramp(closure, theta_l, theta_v, phi):
-    """One knot of OSL's diffuse_ramp: hat_j(cos θl)/π (no further cos θl:
-    the ramp is the whole light dependence), lights above the surface."""
+def _diffuse_ramp_parts(closure, theta_l, theta_v, phi):
+    """OSL's diffuse_ramp as (ramp position, factor): cos θl and 1/π (no
+    further cos θl: the ramp is the whole light dependence), lights and
+    views above the surface."""
     up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2)
-    return np.where(up, ramp_hat(np.cos(theta_l), closure.knot) / np.pi, 0.0)
+    return np.cos(theta_l), np.where(up, 1.0 / np.pi, 0.0)
 
 
-def _phong_ramp(closure, theta_l, theta_v, phi):
-    """One knot of OSL's phong_ramp of exponent e: p = (R·l)^e with R the
-    mirror of the view, hat_j(p)·p·(e + 2)/(2π)·cos θl where R·l > 0."""
+def _phong_ramp_parts(closure, theta_l, theta_v, phi):
+    """OSL's phong_ramp of exponent e as (ramp position, factor): p = (R·l)^e
+    with R the mirror of the view, and p·(e + 2)/(2π)·cos θl where R·l > 0."""
     cos_rl = np.sin(theta_v) * np.cos(phi) * np.sin(theta_l) + np.cos(theta_v) * np.cos(theta_l)
     e = max(float(closure.exponent), 0.0)
     p = np.maximum(cos_rl, 0.0) ** e
-    value = ramp_hat(p, closure.knot) * p * (e + 2.0) / (2.0 * np.pi) * np.cos(theta_l)
     up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2) & (cos_rl > 0)
-    return np.where(up, value, 0.0)
+    return p, np.where(up, p * (e + 2.0) / (2.0 * np.pi) * np.cos(theta_l), 0.0)
+
+
+_RAMP_PARTS = {"diffuse_ramp": _diffuse_ramp_parts, "phong_ramp": _phong_ramp_parts}
+
+
+def _ramp_knot(closure, theta_l, theta_v, phi):
+    """One knot j of a ramp: hat_j(position)·factor (``_RAMP_PARTS``)."""
+    position, factor = _RAMP_PARTS[closure.kind](closure, theta_l, theta_v, phi)
+    return ramp_hat(position, closure.knot) * factor
+
+
+def evaluate_all(closures, theta_l, theta_v, phi) -> np.ndarray:
+    """Every closure's ``evaluate`` stacked on a last axis, (..., K): a
+    ramp's position and factor are computed once for all its knots."""
+    theta_l, theta_v, phi = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (theta_l, theta_v, phi)))
+    out = np.empty((*theta_l.shape, len(closures)))
+    parts = {}
+    for k, closure in enumerate(closures):
+        if closure.osl:
+            family = (closure.kind, closure.exponent)
+            if family not in parts:
+                parts[family] = _RAMP_PARTS[closure.kind](closure, theta_l, theta_v, phi)
+            position, factor = parts[family]
+            out[..., k] = ramp_hat(position, closure.knot) * factor
+        else:
+            out[..., k] = CLOSURE_KINDS[closure.kind].evaluate(closure, theta_l, theta_v, phi)
+    return out
 
 
 def ramp_closures(exponents=(1.0,)) -> list:
@@ -447,8 +474,8 @@ CLOSURE_KINDS = {
         reflection=True,
         eevee=EeveeResponse(_eevee_retro_glossy, ("roughness",), {"roughness": RETRO_ROUGHNESS}),
     ),
-    "diffuse_ramp": ClosureKind(_diffuse_ramp, cost=0, osl=True),
-    "phong_ramp": ClosureKind(_phong_ramp, cost=0, osl=True),
+    "diffuse_ramp": ClosureKind(_ramp_knot, cost=0, osl=True),
+    "phong_ramp": ClosureKind(_ramp_knot, cost=0, osl=True),
 }
 
 

@@ -209,6 +209,9 @@ class Fit:
     grazing_residual: np.ndarray | None = None
     grazing_reference: np.ndarray | None = None
     eevee_mode: str = "EXACT"
+    #: An OSL variant's: the ``content_key`` of the SVM fit it was made
+    #: from (a cached variant of another Cycles fit is stale).
+    base_key: str = ""
 
     @property
     def sums_exactly(self) -> bool:
@@ -239,6 +242,13 @@ class Fit:
         """Whether it is the OSL variant of a Cycles fit (``fit_osl``): its
         closures include signed ramp knots, which only OSL draws."""
         return any(c.osl for c in self.closures)
+
+    @property
+    def draws_ramps(self) -> bool:
+        """Whether an OSL variant's ramps carry weight: a variant whose ramps
+        did not pay (``fit_osl``) draws its SVM fit alone, and the add-on
+        renders the SVM group for it."""
+        return any(self.closures[k].osl for k, _ in self.rows)
 
     @property
     def goals(self) -> tuple[float, float]:
@@ -313,6 +323,7 @@ class Fit:
             "lut_key": self.lut_key,
             "calibration": list(self.calibration) if self.calibration else None,
             "eevee_mode": self.eevee_mode,
+            **({"base_key": self.base_key} if self.base_key else {}),
         }
 
 
@@ -613,14 +624,21 @@ def model_radiance(lut):
     return _model_radiance(json.dumps(meta["type"], sort_keys=True), single, diffuse, smooth)
 
 
-def measure_grams(model, basis, cos_view, weights, evaluate):
+def measure_grams(model, basis, cos_view, weights, evaluate, *, columns=False):
     """The fidelity measure's Gram matrices of a fit: (residual, reference)
     over the whole grid and over the grazing band, each (T, C, C), from the
     model's radiance ``model`` (``model_radiance``: points and (N, T, C)) and
-    the closures ``basis`` with the weights the node group reads."""
+    the closures ``basis`` with the weights the node group reads: those of
+    ``texture_weights`` for weights fitted at ``cos_view``, or with
+    ``columns`` the weights texture's own columns at ``cos_view``, read at
+    the column nearest to each view."""
     (tl, tv, ph), target = model
     values = np.array([evaluate(c, tl, tv, ph) for c in basis]).reshape(len(basis), tl.size)  # (K, N); K may be 0
-    fitted = np.einsum("kn,kcnt->ntc", values, texture_weights(weights, cos_view, np.cos(tv)))
+    if columns:
+        read = weights[:, :, nearest_column(len(cos_view), np.cos(tv)), :]
+    else:
+        read = texture_weights(weights, cos_view, np.cos(tv))
+    fitted = np.einsum("kn,kcnt->ntc", values, read)
     r = fitted - target
     band = measure.grazing(tl)
 
@@ -759,10 +777,70 @@ OSL_EXPONENTS = (1.0, 8.0)
 #: each view's Gram matrix: knots few rows reach (a Phong ramp's top knots
 #: at grazing views) stay near zero instead of following noise of the LUT.
 OSL_RIDGE = 1e-3
-#: Rows beyond the fitted domain where the variant's radiance is checked to
-#: be non-negative (lights to 89.9°: a diffuse ramp's first knot is its
-#: value at the horizon).
-OSL_CHECK_LIGHT = np.radians(89.9)
+#: Lights (θl, degrees) and azimuths (φ) where the variant's radiance is
+#: made non-negative, at every view of every texture column's cell
+#: (``osl_check_views``): the whole upper hemisphere, finer toward the
+#: horizon, where the SVM closures fade as cos θl and a diffuse ramp keeps
+#: its first knot (diffuse_ramp has no cos θl: its value at the horizon).
+OSL_CHECK_LIGHTS = np.radians(
+    np.concatenate(
+        [np.arange(0.0, 75.0, 5.0), [75.0, 77.5, 80.0, 82.0, 84.0, 85.5, 87.0, 88.0, 89.0, 89.5, 89.8, 89.99]]
+    )
+)
+OSL_CHECK_AZIMUTHS = np.radians(np.arange(0.0, 181.0, 15.0))
+#: Offsets (dθl, φ) about each view's mirror direction (θl = θv, φ = 0)
+#: checked as well: the SVM closures' sharp lobes fall off there faster
+#: than the Phong ramps' broad ones.
+OSL_CHECK_MIRROR = (
+    np.radians([-10.0, -6.0, -3.0, -1.5, 0.0, 1.5, 3.0, 6.0, 10.0]),
+    np.radians(np.arange(0.0, 46.0, 3.0)),
+)
+#: The share of the SVM closures' radiance the ramps may take away at a
+#: checked geometry: headroom for the geometries between them.
+OSL_MARGIN = 0.25
+#: The most oblique view the bound is checked at (a view at 90° sees nothing).
+OSL_CHECK_VIEW = np.radians(89.9)
+
+
+def osl_check_views(columns: int) -> np.ndarray:
+    """View cosines (2·columns + 1,) of the weights texture's cells: entry
+    2j + 1 is column j's own view (cos θv = j/(columns - 1)), entries 2j and
+    2j + 2 the edges of the cell it is read over (``nearest_column``),
+    clipped to views up to ``OSL_CHECK_VIEW``."""
+    half = 0.5 / (columns - 1)
+    return np.clip(np.arange(-1, 2 * columns) * half, np.cos(OSL_CHECK_VIEW), 1.0)
+
+
+def nonnegative_factor(svm_closures, ramps, weights, knots, cos_cols, margin=0.0):
+    """The largest factor in [0, 1] per (column, tile, component), (N, T, C),
+    by which the ramps' correction (knots (Q, C, N, T) at the texture's
+    columns ``cos_cols``) can be scaled so that the component's radiance,
+    the SVM closures' (weights (K, C, N, T)) plus the ramps', is nowhere
+    negative at the lights ``OSL_CHECK_LIGHTS`` x ``OSL_CHECK_AZIMUTHS``
+    and about the mirror of the view (``OSL_CHECK_MIRROR``), at every view
+    of each column's cell (``osl_check_views``: the column's weights are
+    read over the whole cell); ``margin``: the share of the SVM radiance
+    the ramps may take away at a checked point, at most."""
+    n_cols = len(cos_cols)
+    theta_v = np.arccos(osl_check_views(n_cols))[:, None]
+    tl, ph = (a.ravel() for a in np.meshgrid(OSL_CHECK_LIGHTS, OSL_CHECK_AZIMUTHS, indexing="ij"))
+    near_l, near_ph = (a.ravel() for a in np.meshgrid(*OSL_CHECK_MIRROR, indexing="ij"))
+    tl = np.concatenate(
+        [np.broadcast_to(tl, (len(theta_v), tl.size)), np.clip(theta_v + near_l, 0.0, OSL_CHECK_LIGHTS[-1])], axis=1
+    )
+    ph = np.broadcast_to(np.concatenate([ph, near_ph]), tl.shape)
+    tv = np.broadcast_to(theta_v, tl.shape)
+
+    svm_v, ramp_v = (closures.evaluate_all(c, tl, tv, ph) for c in (svm_closures, ramps))  # (V, R, K)
+    factor = np.ones((n_cols, weights.shape[3], weights.shape[1]))
+    for offset in range(3):  # the cell's lower edge, the column's view, its upper edge
+        at = slice(offset, offset + 2 * n_cols, 2)
+        svm = np.einsum("nrk,kcnt->nrtc", svm_v[at], weights)
+        corr = np.einsum("nrq,qcnt->nrtc", ramp_v[at], knots)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = np.where(corr < 0, (1.0 - margin) * np.maximum(svm, 0.0) / -corr, np.inf)
+        factor = np.minimum(factor, ratio.min(axis=1))
+    return np.clip(factor, 0.0, 1.0)
 
 
 def fit_osl(
@@ -775,12 +853,14 @@ def fit_osl(
     closures leave on the rows ``row_set`` (``ROW_SETS``) by ridge least
     squares (``ridge``, ``OSL_RIDGE``).
 
-    Bounded so that no colour renders negative radiance: per view and
-    component the ramps' correction is scaled down until the component's
-    radiance (SVM closures plus ramps) is non-negative at every checked
-    light (the rows, and lights to ``OSL_CHECK_LIGHT``); a colour's radiance
-    is a sum of components with non-negative amplitudes, so every colour of
-    the type is non-negative there too.  The ramps are kept only where they
+    Bounded so that no colour renders negative radiance: the diffuse ramp's
+    first knot (its value at the horizon, where the SVM closures fade) is
+    held >= 0, and per column of the weights texture, tile and component
+    the ramps' correction is scaled down until the component's radiance
+    (SVM closures plus ramps) is non-negative over the hemisphere of lights
+    at every view the column is read at (``nonnegative_factor``); a
+    colour's radiance is a sum of components with non-negative amplitudes,
+    so every colour of the type is non-negative there too.  The ramps are kept only where they
     bring the fit nearer its goals on the measure (``shortfall`` against the
     OSL goals, ``measure.GOALS["OSL"]``); otherwise the variant is ``base``
     with zero ramps.  Where OSL is off, the add-on renders ``base``'s
@@ -801,15 +881,10 @@ def fit_osl(
     theta_v = np.arccos(np.clip(cos_view, np.cos(MAX_VIEW), 1.0))
     ramps = closures.ramp_closures(exponents)
 
-    def radiance_parts(theta_l, phi):
-        tv = np.broadcast_to(theta_v[:, None], theta_l.shape)
-        svm = np.stack([c.evaluate(theta_l, tv, phi) for c in base.closures], axis=-1)  # (M, R, K)
-        drawn = np.einsum("mrk,kcmt->mrtc", svm, w_base)
-        ramp = np.stack([c.evaluate(theta_l, tv, phi) for c in ramps], axis=-1)  # (M, R, Q)
-        return tv, drawn, ramp
-
     theta_l, phi, row_w = _rows(validate_row_set(row_set), theta_v, grid)
-    tv, drawn, ramp = radiance_parts(theta_l, phi)
+    tv = np.broadcast_to(theta_v[:, None], theta_l.shape)
+    drawn = np.einsum("mrk,kcmt->mrtc", closures.evaluate_all(base.closures, theta_l, tv, phi), w_base)
+    ramp = closures.evaluate_all(ramps, theta_l, tv, phi)  # (M, R, Q)
     target = lut.components(theta_l, tv, phi) * np.cos(theta_l)[..., None, None]  # (M, R, T, C)
     aw = ramp * row_w[..., None]
     gram = np.einsum("mrq,mrs->mqs", aw, aw)
@@ -817,38 +892,45 @@ def fit_osl(
     scale = np.trace(gram, axis1=1, axis2=2) / len(ramps)
     lam = np.maximum(ridge * scale, 1e-12 * np.maximum(scale, 1e-300))
     system = gram + lam[:, None, None] * np.eye(len(ramps))
-    knots = solve_spd(np.broadcast_to(system[:, None, None], (*rhs.shape, len(ramps))), rhs)  # (M, T, C, Q)
-    # Non-negative radiance: scale each (view, tile, component) correction
-    # by the largest factor <= 1 that keeps it so on the rows and beyond.
-    check_l, check_phi, _ = light_rows(theta_v, grid, max_light=OSL_CHECK_LIGHT)
-    checks = [(theta_l, drawn, ramp), (check_l, *radiance_parts(check_l, check_phi)[1:])]
-    factor = np.ones(knots.shape[:3])
-    for _, svm_part, ramp_part in checks if nonnegative else ():
-        corr = np.einsum("mrq,mtcq->mrtc", ramp_part, knots)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.where(corr < 0, np.maximum(svm_part, 0.0) / -corr, np.inf)
-        factor = np.minimum(factor, ratio.min(axis=1))
-    knots *= np.clip(factor, 0.0, 1.0)[..., None] * (1.0 - 1e-6)
-    weights = np.concatenate([w_base, np.transpose(knots, (3, 2, 0, 1))], axis=0)  # (K + Q, C, M, T)
+    system = np.broadcast_to(system[:, None, None], (*rhs.shape, len(ramps)))
+    knots = solve_spd(system, rhs)  # (M, T, C, Q)
+    if nonnegative:
+        # The diffuse ramp's first knot is its value at the horizon, where
+        # the SVM closures fade as cos θl: it must not be negative.  Where
+        # the free solution makes it so, solve again with it held at 0.
+        held = solve_spd(system[..., 1:, 1:], rhs[..., 1:])
+        knots = np.where(knots[..., :1] < 0, np.concatenate([np.zeros_like(held[..., :1]), held], axis=-1), knots)
+    dense = view_cosines(texture_views(views))
+    weights = resample_views(
+        np.concatenate([w_base, np.transpose(knots, (3, 2, 0, 1))], axis=0), cos_view, dense
+    )  # (K + Q, C, N, T): the weights texture's columns
+    k_ = len(base.closures)
+    if nonnegative:
+        # Non-negative radiance: scale each column's correction, per tile and
+        # component, by the largest factor <= 1 that keeps it so everywhere
+        # the column is read (a colour is a sum of components with
+        # non-negative amplitudes, so every colour is non-negative too).
+        factor = nonnegative_factor(base.closures, ramps, weights[:k_], weights[k_:], dense, margin=OSL_MARGIN)
+        weights[k_:] *= np.transpose(factor, (2, 0, 1))[None] * (1.0 - 1e-6)
     basis = list(base.closures) + ramps
     model = model_radiance(lut)
-    whole, band = measure_grams(model, basis, cos_view, weights, _cycles)
+    whole, band = measure_grams(model, basis, dense, weights, _cycles, columns=True)
     goals = measure.goals("OSL", base.mirror)
     if base.weights.shape[3] > 1 or shortfall(whole, band, goals) >= shortfall(
         (base.residual, base.reference), (base.grazing_residual, base.grazing_reference), goals
     ):
         weights[len(base.closures) :] = 0.0  # the ramps do not pay: the SVM fit as it is
         whole, band = (base.residual, base.reference), (base.grazing_residual, base.grazing_reference)
-    dense = view_cosines(texture_views(views))
     return dataclasses.replace(
         base,
         closures=basis,
         cos_view=dense,
-        weights=resample_views(weights, cos_view, dense),
+        weights=weights,
         residual=whole[0],
         reference=whole[1],
         grazing_residual=band[0],
         grazing_reference=band[1],
+        base_key=content_key(base),
     )
 
 
@@ -1089,6 +1171,13 @@ def _hash(header_json: str, image: np.ndarray) -> str:
     return h.hexdigest()
 
 
+def content_key(fitted: Fit) -> str:
+    """What identifies a fit's content: the hash its weights file carries
+    (its header and weights texture), the same for a fit and its file read
+    back."""
+    return _hash(lutfile.canonical_json(fitted.header()), _image(fitted))
+
+
 def write_fit(fitted: Fit, path) -> pathlib.Path:
     """Write a fit's weights texture and header atomically: row r (counted
     from the bottom, where a Blender image has v = 0) holds at the view
@@ -1135,6 +1224,7 @@ def read_fit(path) -> Fit:
             grazing_residual=np.array(h["grazing_residual"], dtype=float),
             grazing_reference=np.array(h["grazing_reference"], dtype=float),
             eevee_mode=validate_eevee_mode(h.get("eevee_mode", "EXACT")),
+            base_key=h.get("base_key", ""),
         )
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         if isinstance(exc, lutfile.LUTError):
