@@ -184,8 +184,12 @@ def store_result(material, paint: lut.Paint, result: render_bake.RenderBake, exa
     groups = {
         target: nodes.build_group(fit, result.fit_paths[target], exact_metallic) for target, fit in result.fits.items()
     }
-    if settings.osl and result.osl is not None and "CYCLES" in groups:  # Cycles' OSL variant (addon.osl)
-        groups["CYCLES"] = nodes.build_group(result.osl, result.osl_path, exact_metallic)
+    settings.osl_problem = ""
+    if settings.osl and result.drawn_osl is not None and "CYCLES" in groups:  # Cycles' OSL variant (addon.osl)
+        try:
+            groups["CYCLES"] = nodes.build_group(result.osl, result.osl_path, exact_metallic)
+        except (RuntimeError, ImportError, AttributeError) as exc:  # no OSL compiler in this Blender
+            settings.osl_problem = f"The OSL variant could not be built ({exc or type(exc).__name__})"
     nodes.wire(material, groups, render_bake.node_inputs(paint, result.lut.internal_reflectance))
     settings.internal_reflectance = result.lut.internal_reflectance
     settings.diffuse_albedo = render_bake.diffuse_albedo(result.lut)
@@ -197,6 +201,7 @@ def store_result(material, paint: lut.Paint, result: render_bake.RenderBake, exa
                 **(_drawing(f) if target == "EEVEE" else {}),
             }
             for target, f in result.variants().items()
+            if target != OSL_VARIANT or result.drawn_osl is not None  # a variant without ramps is the SVM fit
         }
     )  # fmt: skip
     export.update_fallback(material, paint)
@@ -272,7 +277,7 @@ def _result_errors(result: render_bake.RenderBake, paint, osl=False) -> dict:
     variant too with ``osl``: a material that uses it)."""
     out = {}
     for target, (whole, grazing) in result.all_errors(paint).items():
-        if target == OSL_VARIANT and not osl:
+        if target == OSL_VARIANT and not (osl and result.drawn_osl is not None):
             continue
         fit = result.variants()[target]
         out[target] = FitError(whole, fit.goals[0], grazing, fit.goals[1], **_drawn(target, _drawing(fit), whole))
@@ -440,9 +445,16 @@ def is_current(material, paint, *, directory=None, exact_metallic=None, **option
         if not path.stem.endswith(table.key[:24]):  # another type's LUT renamed onto this one's name
             return False
         for target in engine_targets():
-            variant = target == "CYCLES" and settings.osl  # the Cycles group draws the OSL variant
-            fit_file = lut.render.fitting.fit_path(path, target, exact, eevee_calibration(), eevee_mode(), osl=variant)
+            fit_file = lut.render.fitting.fit_path(path, target, exact, eevee_calibration(), eevee_mode())
             fitted = lut.render.fitting.read_fit(fit_file)
+            if target == "CYCLES" and settings.osl and not settings.osl_problem:
+                # The Cycles group draws the OSL variant, where its ramps carry weight.
+                variant_file = lut.render.fitting.fit_path(path, target, exact, osl=True)
+                variant = lut.render.fitting.read_fit(variant_file)
+                if variant.base_key != lut.render.fitting.content_key(fitted):
+                    return False
+                if variant.draws_ramps:
+                    fit_file, fitted = variant_file, variant
             if fitted.lut_key != table.key or fitted.target != target:
                 return False
             node = nodes.group_of(material, target)

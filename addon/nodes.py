@@ -152,7 +152,19 @@ def build_group(fit: fitting.Fit, weights_path, exact_metallic=None):
     if old is not None:
         old.name = f"{name} (old)"  # materials that use it keep it until rewired
     group = bpy.data.node_groups.new(name, "ShaderNodeTree")
-    group["paint_lut_fit"] = fit_id
+    try:
+        _fill_group(group, fit, weights_path, exact_metallic)
+    except Exception:  # e.g. no OSL compiler for the variant's Script node: leave no half-built group
+        bpy.data.node_groups.remove(group)
+        if old is not None:
+            old.name = name
+        raise
+    group["paint_lut_fit"] = fit_id  # only a whole group is found again by its fit
+    return group
+
+
+def _fill_group(group, fit: fitting.Fit, weights_path, exact_metallic):
+    """Build ``build_group``'s nodes into the new, empty ``group``."""
     if fit.target == "EEVEE":
         group["paint_lut_eevee_mode"] = fit.eevee_mode
     if hasattr(group, "description"):
@@ -215,7 +227,6 @@ def build_group(fit: fitting.Fit, weights_path, exact_metallic=None):
     if total is None:  # nothing to render (cannot happen for a fitted type, kept safe)
         total = tree.nodes.new("ShaderNodeBsdfTransparent").outputs[0]
     links.new(total, out.inputs["Shader"])
-    return group
 
 
 def group_weights_path(group):

@@ -34,6 +34,7 @@ def draw_settings(layout, material, scene=None):
     elif settings.lut_path:
         layout.label(text=bpy.path.basename(settings.lut_path), icon="CHECKMARK")
         errors = api.fit_errors(material, variants=True)
+        has_variant = api.OSL_VARIANT in errors  # a bake stores the variant only where its ramps carry weight
         offer = errors.pop(api.OSL_VARIANT, None) if not settings.osl else None
         for target, fit in errors.items():
             layout.label(text=fit_error_text(target, fit), icon="ERROR" if fit.missed else "CHECKMARK")
@@ -44,8 +45,11 @@ def draw_settings(layout, material, scene=None):
             layout.prop(settings, "osl")
             if offer is not None:
                 layout.label(text=offer_text(offer), icon="INFO")
-            if scene is not None:
-                layout.label(text=variant_text(settings.osl, api.cycles_variant(material, scene)), icon="INFO")
+            if settings.osl_problem:
+                layout.label(text=settings.osl_problem, icon="ERROR")
+            elif scene is not None:
+                drawn = api.cycles_variant(material, scene)
+                layout.label(text=variant_text(settings.osl, drawn, has_variant), icon="INFO")
     if scene is not None and getattr(scene, "paint_lut", None) is not None:
         layout.prop(scene.paint_lut, "eevee_mode", text="EEVEE (scene)")
 
@@ -71,11 +75,15 @@ def offer_text(fit) -> str:
     )
 
 
-def variant_text(asked: bool, drawn: str) -> str:
+def variant_text(asked: bool, drawn: str, has_variant: bool = True) -> str:
     """The panel's line on what Cycles draws of the material in this scene
-    (``api.cycles_variant``)."""
+    (``api.cycles_variant``); ``has_variant``: whether the type's OSL
+    variant has ramps at all (where they do not bring it nearer its goals
+    it is the SVM fit, and Cycles renders that with OSL on or off)."""
     if drawn == "OSL":
         return "Cycles renders the OSL variant here"
+    if not has_variant:
+        return "The OSL ramps do not improve this paint type: Cycles renders its SVM closures"
     if asked:
         return "Cycles renders the SVM closures here: turn Open Shading Language on (CPU or OptiX) for the OSL variant"
     return "Cycles renders the SVM closures; the OSL variant needs Open Shading Language (CPU or OptiX)"

@@ -194,6 +194,10 @@ class PaintLUTSettings(bpy.types.PropertyGroup):
         name="Preset", items=_preset_items, default=0, update=_preset_changed,
         description="One of the paper's three paints, or Custom",
     )  # fmt: skip
+    osl_problem: bpy.props.StringProperty(
+        name="OSL Problem", options={"HIDDEN"},
+        description="Why the Cycles OSL variant could not be built here (the SVM group renders instead)",
+    )  # fmt: skip
     lut_path: bpy.props.StringProperty(
         name="LUT", subtype="FILE_PATH", description="The baked lookup table", options=_RELATIVE_PATH,
     )  # fmt: skip

@@ -12,6 +12,7 @@ import pytest
 bpy = pytest.importorskip("bpy")
 
 import lut  # noqa: E402
+from lut import bench  # noqa: E402
 from lut.render import bake as render_bake  # noqa: E402
 from lut.render import fitting, measure  # noqa: E402
 
@@ -59,7 +60,7 @@ def test_defaults_are_the_paint_defaults(material):
 
 #: The material settings that are not paint fields.
 NOT_PAINT_FIELDS = {"rna_type", "name", "enabled", "preset", "lut_path", "stale", "internal_reflectance",
-                    "diffuse_albedo", "seen", "fits", "spectral_paint", "osl"}  # fmt: skip
+                    "diffuse_albedo", "seen", "fits", "spectral_paint", "osl", "osl_problem"}  # fmt: skip
 
 
 def _float32(value):
@@ -790,3 +791,61 @@ def test_the_osl_setting_switches_the_cycles_group_without_a_bake(material, lut_
 
     material.paint_lut.osl = False
     assert nodes.group_of(material, "CYCLES").node_tree == svm
+
+
+def test_a_variant_whose_ramps_do_not_pay_renders_the_svm_group_and_says_so(material, lut_dir):
+    """Where the ramps do not bring a type nearer its goals its variant is
+    the SVM fit: the bake stores no OSL figures (nothing to offer), and
+    with the setting on the material keeps its SVM group, is current (no
+    bake every time) and the panel says the ramps add nothing, not to turn
+    OSL on."""
+    from addon import api, nodes, panels
+
+    _label, paint = bench.random_paints(8, seed=31)[4]  # a smooth type whose ramps the fit drops
+    api.set_paint(material, paint)
+    result = api.bake_material(material, directory=lut_dir)
+    assert result.osl is not None and result.drawn_osl is None, "the case needs a type whose ramps are dropped"
+    assert api.OSL_VARIANT not in api.fit_errors(material, variants=True)
+    svm = nodes.group_of(material, "CYCLES").node_tree
+    material.paint_lut.osl = True
+    assert nodes.group_of(material, "CYCLES").node_tree == svm
+    assert api.is_current(material, api.paint_of(material), directory=lut_dir)
+    assert api.cycles_variant(material, bpy.context.scene) == "SVM"
+    layout = _Layout()
+    panels.draw_settings(layout, material, bpy.context.scene)
+    assert any(t.startswith("The OSL ramps do not improve this paint type") for t, _ in layout.labels)
+    assert not any("turn Open Shading Language on" in t for t, _ in layout.labels)
+
+
+def test_a_blender_that_cannot_compile_the_ramps_keeps_the_svm_group_and_says_why(material, lut_dir, monkeypatch):
+    """Turning the variant on where Cycles' OSL compiler fails (a build
+    without OSL) is no error: the SVM group stays wired, no half-built
+    group is left, the panel names the problem and a bake of the file does
+    not fail for it; once the shader compiles, switching again builds it."""
+    from addon import api, nodes, osl, panels
+
+    api.set_paint(material, lut.Paint(rho=(0.02, 0.03, 0.02), slope=1.5, distribution="gaussian"))
+    api.bake_material(material, directory=lut_dir, **SMALL)
+    svm = nodes.group_of(material, "CYCLES").node_tree
+    groups = set(bpy.data.node_groups.keys())
+
+    def no_compiler():
+        raise RuntimeError("Cycles could not compile paint_lut_ramps.osl")
+
+    monkeypatch.setattr(osl, "_compiled", no_compiler)  # the failure a Blender without OSL gives
+    material.paint_lut.osl = True
+    assert nodes.group_of(material, "CYCLES").node_tree == svm
+    assert set(bpy.data.node_groups.keys()) == groups
+    assert "could not compile" in material.paint_lut.osl_problem
+    layout = _Layout()
+    panels.draw_settings(layout, material, bpy.context.scene)
+    assert any(t == material.paint_lut.osl_problem for t, _ in layout.labels)
+    status = api.bake_materials({material}, force=True, directory=lut_dir, **SMALL)
+    assert status[material.name].state == "baked"
+    assert api.is_current(material, api.paint_of(material), directory=lut_dir, **SMALL)
+
+    monkeypatch.undo()
+    material.paint_lut.osl = False
+    material.paint_lut.osl = True
+    assert material.paint_lut.osl_problem == ""
+    assert any(nd.type == "SCRIPT" for nd in nodes.group_of(material, "CYCLES").node_tree.nodes)
