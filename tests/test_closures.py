@@ -397,8 +397,8 @@ def test_randomised_types_fit_within_their_targets():
 
 
 def test_the_batched_spd_solver_is_numpys_solve():
-    """``nnls.solve_spd`` (elimination over a batch, no LAPACK call per
-    matrix) agrees with numpy's solve on random positive definite systems,
+    """``nnls.solve_spd`` (a batched Cholesky factor and substitution over
+    the batch, no LAPACK solve per matrix) agrees with numpy's solve on random positive definite systems,
     regularised near-singular ones and 1x1 ones."""
     from lut.render.nnls import solve_spd
 
@@ -412,6 +412,10 @@ def test_the_batched_spd_solver_is_numpys_solve():
     b = rng.normal(size=(30, 7))
     np.testing.assert_allclose(solve_spd(a, b), np.linalg.solve(a, b[..., None])[..., 0], rtol=1e-10, atol=1e-12)
     assert solve_spd(np.array([[4.0]]), np.array([2.0])) == pytest.approx([0.5])
+    # A matrix of the batch that is not positive definite (its Cholesky
+    # factor does not exist) sends the whole batch to elimination.
+    a[3] = [[1.0 if i == j else (2.0 if abs(i - j) == 1 else 0.0) for j in range(7)] for i in range(7)]
+    np.testing.assert_allclose(solve_spd(a, b), np.linalg.solve(a, b[..., None])[..., 0], rtol=1e-9, atol=1e-11)
 
 
 @pytest.mark.parametrize("target", ["CYCLES", "EEVEE"])
