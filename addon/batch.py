@@ -223,6 +223,8 @@ def _fit_entry(material) -> dict:
     # What Cycles draws of it in the file's scene: "OSL" (its OSL variant,
     # whose errors are listed as "OSL") or "SVM".
     entry["cycles_variant"] = api.cycles_variant(material)
+    if material.paint_lut.osl_problem:  # the OSL variant was asked for and could not be built here
+        entry["osl_problem"] = material.paint_lut.osl_problem
     misses = []
     for t, f in errors.items():
         if f.error > f.target:

@@ -822,7 +822,7 @@ def test_a_blender_that_cannot_compile_the_ramps_keeps_the_svm_group_and_says_wh
     without OSL) is no error: the SVM group stays wired, no half-built
     group is left, the panel names the problem and a bake of the file does
     not fail for it; once the shader compiles, switching again builds it."""
-    from addon import api, nodes, osl, panels
+    from addon import api, batch, nodes, osl, panels
 
     api.set_paint(material, lut.Paint(rho=(0.02, 0.03, 0.02), slope=1.5, distribution="gaussian"))
     api.bake_material(material, directory=lut_dir, **SMALL)
@@ -842,6 +842,8 @@ def test_a_blender_that_cannot_compile_the_ramps_keeps_the_svm_group_and_says_wh
     assert any(t == material.paint_lut.osl_problem for t, _ in layout.labels)
     status = api.bake_materials({material}, force=True, directory=lut_dir, **SMALL)
     assert status[material.name].state == "baked"
+    entry = batch._fit_entry(material)
+    assert entry["cycles_variant"] == "SVM" and entry["osl_problem"] == material.paint_lut.osl_problem
     assert api.is_current(material, api.paint_of(material), directory=lut_dir, **SMALL)
 
     monkeypatch.undo()
