@@ -803,12 +803,14 @@ OSL_CHECK_VIEW = np.radians(89.9)
 
 
 def osl_check_views(columns: int) -> np.ndarray:
-    """View cosines (2·columns + 1,) of the weights texture's cells: entry
-    2j + 1 is column j's own view (cos θv = j/(columns - 1)), entries 2j and
-    2j + 2 the edges of the cell it is read over (``nearest_column``),
-    clipped to views up to ``OSL_CHECK_VIEW``."""
-    half = 0.5 / (columns - 1)
-    return np.clip(np.arange(-1, 2 * columns) * half, np.cos(OSL_CHECK_VIEW), 1.0)
+    """View cosines (columns + 1,) of the edges of the weights texture's
+    cells: column j (cos θv = j/(columns - 1)) is read over the views
+    between entries j and j + 1 (``nearest_column``), clipped to views up
+    to ``OSL_CHECK_VIEW``.  The bound is checked at both edges of a cell:
+    a column's weights are constant over it and the closures vary slowly
+    across it (under half a degree of θv away from the normal), which the
+    margin (``OSL_MARGIN``) covers."""
+    return np.clip((np.arange(columns + 1) - 0.5) / (columns - 1), np.cos(OSL_CHECK_VIEW), 1.0)
 
 
 def nonnegative_factor(svm_closures, ramps, weights, knots, cos_cols, margin=0.0):
@@ -817,7 +819,7 @@ def nonnegative_factor(svm_closures, ramps, weights, knots, cos_cols, margin=0.0
     columns ``cos_cols``) can be scaled so that the component's radiance,
     the SVM closures' (weights (K, C, N, T)) plus the ramps', is nowhere
     negative at the lights ``OSL_CHECK_LIGHTS`` x ``OSL_CHECK_AZIMUTHS``
-    and about the mirror of the view (``OSL_CHECK_MIRROR``), at every view
+    and about the mirror of the view (``OSL_CHECK_MIRROR``), at both edges
     of each column's cell (``osl_check_views``: the column's weights are
     read over the whole cell); ``margin``: the share of the SVM radiance
     the ramps may take away at a checked point, at most."""
@@ -833,8 +835,8 @@ def nonnegative_factor(svm_closures, ramps, weights, knots, cos_cols, margin=0.0
 
     svm_v, ramp_v = (closures.evaluate_all(c, tl, tv, ph) for c in (svm_closures, ramps))  # (V, R, K)
     factor = np.ones((n_cols, weights.shape[3], weights.shape[1]))
-    for offset in range(3):  # the cell's lower edge, the column's view, its upper edge
-        at = slice(offset, offset + 2 * n_cols, 2)
+    for edge in range(2):  # each column's cell, its lower and upper edge
+        at = slice(edge, edge + n_cols)
         svm = np.einsum("nrk,kcnt->nrtc", svm_v[at], weights)
         corr = np.einsum("nrq,qcnt->nrtc", ramp_v[at], knots)
         with np.errstate(divide="ignore", invalid="ignore"):
