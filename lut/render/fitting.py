@@ -511,6 +511,29 @@ def _nnls_fit(gram, rhs, norm, idx, upper, start=None):
     return x, float(_relative(np.maximum(err, 0.0), norm))
 
 
+def _nnls_fits(gram, rhs, norm, idx, upper, start=None):
+    """``_nnls_fit`` of several targets on the same closures ``idx`` at
+    once: rhs (M, P, K), norm (M, P, 2), start (M, P, s) or None; returns
+    (x (M, P, s), relative squared errors (P,)).  Each (view, target) is its
+    own problem in one batch, with the same solution as alone."""
+    idx = list(idx)
+    m_, p_ = rhs.shape[:2]
+    sub = np.repeat(gram[:, idx][:, :, idx], p_, axis=0)  # (M·P, s, s): view m's Gram for each target
+    g = rhs[:, :, idx].reshape(m_ * p_, len(idx))
+    n0 = norm[:, :, 0].reshape(-1)
+    scale = np.maximum(np.abs(np.diagonal(sub, axis1=-2, axis2=-1)).max(axis=-1), 1e-300)
+    x = solve_spd(sub + 1e-13 * scale[:, None, None] * np.eye(len(idx)), g)
+    bad = (np.any(x < 0, axis=1) | np.any(x > upper, axis=1)) & (n0 > 0)
+    if bad.any():
+        warm = None if start is None else start.reshape(m_ * p_, len(idx))[bad]
+        x[bad] = nnls_gram_batch(sub[bad], g[bad], upper=upper, start=warm)
+    x[n0 == 0] = 0.0
+    err = n0 - 2 * np.sum(x * g, axis=1) + np.einsum("ns,nst,nt->n", x, sub, x)
+    err = np.maximum(err, 0.0).reshape(m_, p_)
+    rel = [float(_relative(err[:, q], norm[:, q])) for q in range(p_)]
+    return x.reshape(m_, p_, len(idx)), rel
+
+
 def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None, start=()):
     """Forward selection of closures for every (tile, component) target.
     gram (M, K, K); rhs (M, P, K), norm (M, P, 2) over P targets; allowed
@@ -564,11 +587,15 @@ def _select(gram, rhs, norm, allowed, upper, cost, budget, goal, caps=None, star
                 break  # the proxy's best few were checked and one helps
             k = cands[i]
             trial, trial_solutions = dict(errors), dict(solutions)
+            groups = {}  # the targets k serves, by the closures each would be fitted on
             for p in targets:
                 if allowed[p, k]:
-                    idx = [j for j in chosen + [k] if allowed[p, j]]
-                    warm = np.pad(solutions[p], ((0, 0), (0, 1)))  # k enters last, at zero
-                    trial_solutions[p], trial[p] = _nnls_fit(gram, rhs[:, p], norm[:, p], idx, upper[idx], warm)
+                    groups.setdefault(tuple(j for j in chosen + [k] if allowed[p, j]), []).append(p)
+            for idx, ps in groups.items():
+                warm = np.stack([np.pad(solutions[p], ((0, 0), (0, 1))) for p in ps], axis=1)  # k enters last, at zero
+                x, rel = _nnls_fits(gram, rhs[:, ps], norm[:, ps], idx, upper[list(idx)], warm)
+                for q, p in enumerate(ps):
+                    trial_solutions[p], trial[p] = x[:, q], rel[q]
             gain = (current - sum(trial.values())) / cost[k]  # error reduction per unit of render cost
             if gain > max(best_gain, 1e-9):
                 best, best_gain, best_errors, best_solutions = k, gain, trial, trial_solutions
