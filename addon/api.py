@@ -246,8 +246,9 @@ def fit_errors(material, *, variants=False) -> dict:
     bake's fits: the fidelity measure (``lut.render.measure``) over its whole
     grid and over the grazing band, with their goals
     (``lut.render.fitting.reported_errors``); empty before a bake.  Cycles'
-    OSL variant is "OSL" (``OSL_VARIANT``) where the material uses it, or
-    with ``variants`` wherever it was baked (what the variant would render).
+    OSL variant is "OSL" (``OSL_VARIANT``) where the material uses it (its
+    setting is on and the variant could be built here), or with
+    ``variants`` wherever it was baked with ramps (what it would render).
     A bake stored without the grazing band's matrices (an earlier release)
     reports the whole figure for the band too."""
     settings = material.paint_lut
@@ -263,7 +264,7 @@ def fit_errors(material, *, variants=False) -> dict:
     )
     out = {}
     for target, f in fits.items():
-        if target == OSL_VARIANT and not (variants or settings.osl):
+        if target == OSL_VARIANT and not (variants or (settings.osl and not settings.osl_problem)):
             continue
         whole, grazing = fitting.reported_errors(f, amps)
         kind = measure.goals(target, paint.slope == 0)  # an earlier release stored the whole goal alone
@@ -492,7 +493,8 @@ def bake_materials(used, force=False, *, directory=None, exact_metallic=None, **
                 status[material.name] = _status("cached", errors, key)
                 continue
             result = bake_material(material, directory=directory, force=force, exact_metallic=exact_metallic, **options)
-            errors = _result_errors(result, paint, material.paint_lut.osl)
+            settings = material.paint_lut
+            errors = _result_errors(result, paint, settings.osl and not settings.osl_problem)
             status[material.name] = _status("baked", errors, result.lut_path.stem.split("-")[-1])
         except (ValueError, OSError, RuntimeError, TypeError, KeyError) as exc:
             status[material.name] = BakeStatus("failed", str(exc) or type(exc).__name__)

@@ -461,17 +461,18 @@ def _osl_ramps(tree, links, lay, fit, ramps, amps):
     node = lay.place(osl.ramps_node(tree), "closures", "Closures")
     for name, socket in osl.AMPLITUDES.items():
         links.new(amps[name], node.inputs[socket])
-    families = []
+    phong = []
     for closure in fit.closures:
-        family = (closure.kind, closure.exponent) if closure.osl else None
-        if family is not None and family not in families:
-            families.append(family)
-    if len(families) > len(osl.FAMILIES) or (families and families[0][0] != "diffuse_ramp"):
-        raise ValueError(f"the OSL ramps shader draws one diffuse and two Phong ramps, not {families}")
-    letter = dict(zip(families, osl.FAMILIES[: len(families)], strict=True))
+        if closure.kind == "phong_ramp" and closure.exponent not in phong:
+            phong.append(closure.exponent)
+    letters = [f for f in osl.FAMILIES if f not in osl.KIND_FAMILY.values()]
+    kinds = {c.kind for c in fit.closures if c.osl}
+    if len(phong) > len(letters) or kinds - set(osl.KIND_FAMILY) - {"phong_ramp"}:
+        raise ValueError(f"the OSL ramps shader draws a diffuse, a retro and two Phong ramps, not {sorted(kinds)}")
+    phong_letter = dict(zip(phong, letters, strict=False))
     for (k, c), colour in ramps.items():
         closure = fit.closures[k]
-        family = letter[(closure.kind, closure.exponent)]
+        family = phong_letter[closure.exponent] if closure.kind == "phong_ramp" else osl.KIND_FAMILY[closure.kind]
         links.new(colour, node.inputs[osl.weight_input(family, fitting.COMPONENTS[c], closure.knot // 3)])
         if family in osl.EXPONENTS:
             node.inputs[osl.EXPONENTS[family]].default_value = closure.exponent

@@ -29,9 +29,13 @@ import bpy
 SOURCE = pathlib.Path(__file__).resolve().parent / "shaders" / "paint_lut_ramps.osl"
 TEXT_NAME = "paint_lut_ramps.osl"
 OUTPUT = "Ramps"
-#: The shader's ramps in the order of a fit's ramp families
-#: (``closures.ramp_closures``: the diffuse ramp, then a Phong ramp per exponent).
-FAMILIES = ("D", "P", "Q")
+#: The shader's ramps: the diffuse ramp, a Phong ramp per exponent (in the
+#: order of a fit's ramp families, ``closures.ramp_closures``) and the
+#: diffuse ramp about the view.
+FAMILIES = ("D", "P", "Q", "R")
+#: The shader's letter of each ramp kind drawn once (the Phong ramps take
+#: the remaining letters in order).
+KIND_FAMILY = {"diffuse_ramp": "D", "retro_ramp": "R"}
 #: The Phong ramps' exponent inputs.
 EXPONENTS = {"P": "P_exponent", "Q": "Q_exponent"}
 AMPLITUDES = {"facet": "Facet", "single": "Single", "diffuse": "Diffuse"}

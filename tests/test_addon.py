@@ -12,7 +12,6 @@ import pytest
 bpy = pytest.importorskip("bpy")
 
 import lut  # noqa: E402
-from lut import bench  # noqa: E402
 from lut.render import bake as render_bake  # noqa: E402
 from lut.render import fitting, measure  # noqa: E402
 
@@ -454,7 +453,11 @@ def test_saved_files_reference_luts_relatively(fresh_file, tmp_path):
     assert image.filepath.startswith("//paint_lut/paintfit-")
     assert (tmp_path / "paint_lut").is_dir()
     assert "UNDO" in operators.PAINTLUT_OT_bake.bl_options
-    assert json.loads(material.paint_lut.fits).keys() == {"CYCLES", "EEVEE", "OSL"}  # OSL: Cycles' OSL variant
+    # Cycles' OSL variant is stored as "OSL" where its ramps carry weight (a variant without them is the SVM fit).
+    lut_file = pathlib.Path(bpy.path.abspath(material.paint_lut.lut_path))
+    variant = fitting.read_fit(fitting.fit_path(lut_file, "CYCLES", api.nodes.EXACT_METALLIC, osl=True))
+    expected = {"CYCLES", "EEVEE"} | ({"OSL"} if variant.draws_ramps else set())
+    assert json.loads(material.paint_lut.fits).keys() == expected
 
 
 def test_save_as_elsewhere_rebakes_what_points_at_the_old_folder(fresh_file, tmp_path):
@@ -794,14 +797,15 @@ def test_the_osl_setting_switches_the_cycles_group_without_a_bake(material, lut_
 
 
 def test_a_variant_whose_ramps_do_not_pay_renders_the_svm_group_and_says_so(material, lut_dir):
-    """Where the ramps do not bring a type nearer its goals its variant is
+    """Where the variant has no ramps (a dispersive type, whose weights are
+    per channel; or ramps that do not bring a type nearer its goals) it is
     the SVM fit: the bake stores no OSL figures (nothing to offer), and
     with the setting on the material keeps its SVM group, is current (no
     bake every time) and the panel says the ramps add nothing, not to turn
     OSL on."""
     from addon import api, nodes, panels
 
-    _label, paint = bench.random_paints(8, seed=31)[4]  # a smooth type whose ramps the fit drops
+    paint = lut.Paint(n=(1.49, 0.006), rho="ColorChecker N Ohta/red")  # dispersive: the ramps are not fitted
     api.set_paint(material, paint)
     result = api.bake_material(material, directory=lut_dir)
     assert result.osl is not None and result.drawn_osl is None, "the case needs a type whose ramps are dropped"
@@ -837,11 +841,12 @@ def test_a_blender_that_cannot_compile_the_ramps_keeps_the_svm_group_and_says_wh
     assert nodes.group_of(material, "CYCLES").node_tree == svm
     assert set(bpy.data.node_groups.keys()) == groups
     assert "could not compile" in material.paint_lut.osl_problem
+    assert api.OSL_VARIANT not in api.fit_errors(material)  # the SVM closures render: their figures
     layout = _Layout()
     panels.draw_settings(layout, material, bpy.context.scene)
     assert any(t == material.paint_lut.osl_problem for t, _ in layout.labels)
     status = api.bake_materials({material}, force=True, directory=lut_dir, **SMALL)
-    assert status[material.name].state == "baked"
+    assert status[material.name].state == "baked" and api.OSL_VARIANT not in status[material.name].errors
     entry = batch._fit_entry(material)
     assert entry["cycles_variant"] == "SVM" and entry["osl_problem"] == material.paint_lut.osl_problem
     assert api.is_current(material, api.paint_of(material), directory=lut_dir, **SMALL)

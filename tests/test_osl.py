@@ -40,6 +40,12 @@ def test_ramp_knots_are_the_ramps_of_cycles_osl():
     r_dot_l = np.sin(tv) * np.cos(ph) * np.sin(tl) + np.cos(tv) * np.cos(tl)
     expected = np.where(r_dot_l > 0, (e + 2) / (2 * np.pi) * np.maximum(r_dot_l, 0) ** e * np.cos(tl), 0.0)
     np.testing.assert_allclose(phong, expected, atol=1e-12)
+    # The diffuse ramp about the view: equal knots give Cycles' bump
+    # shadowing term over π where l·v > 0 (the retro Toon's factor), else 0.
+    retro = sum(c.evaluate(tl, tv, ph) for c in closures.ramp_closures((), retro=True) if c.kind == "retro_ramp")
+    l_dot_v = -np.sin(tl) * np.sin(tv) * np.cos(ph) + np.cos(tl) * np.cos(tv)
+    np.testing.assert_allclose(retro, np.where(l_dot_v > 0, closures.bump_shadowing(tl, tv) / np.pi, 0.0))
+    assert (l_dot_v > 0).any() and (l_dot_v < 0).any() and np.all(closures.bump_shadowing(tl, tv) < 1.0)
     # One knot alone: its hat at the ramp's position (cos θl = 2/7 is knot 2's peak).
     knot = closures.Closure("diffuse_ramp", knot=2)
     assert knot.evaluate(np.arccos(2 / 7), 0.3, 0.0) == pytest.approx(1 / np.pi)

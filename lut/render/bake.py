@@ -91,6 +91,10 @@ def _cached_fit(path, lut, target, exact_metallic, calibration, eevee_mode="EXAC
         return None
     if base is not None and fitted.base_key != fitting.content_key(base):
         return None
+    if osl and [c for c in fitted.closures if c.osl] != closures.ramp_closures(
+        fitting.OSL_EXPONENTS, fitting.OSL_RETRO
+    ):
+        return None  # a variant of other ramps (an earlier release's): fitted again
     return fitted
 
 

@@ -54,6 +54,13 @@ irradiance, cos θl included (what Cycles' eval returns), for a white closure:
 * ``phong_ramp``:   one knot j of OSL's ``phong_ramp(N, e, colors[8])``
   (Cycles' bsdf_phong_ramp.h): with p = (R·l)^e, R the mirror of the view,
   hat_j(p)·p·(e + 2)/(2π)·cos θl where R·l > 0, else 0.  Signed.
+* ``retro_ramp``:   one knot j of OSL's ``diffuse_ramp(V, colors[8])`` with
+  the view direction V as its normal: the ramp over cos γ, γ the angle
+  between the light and the viewer, divided by π, times Cycles' bump
+  shadowing term for a diffuse closure whose normal is not the surface's
+  (as ``retro_toon``), where the light is above the surface and l·v > 0.
+  Signed: a lobe about the retro-reflection direction, for back-scattering
+  pigments (g < 0), which neither other ramp follows.
 
 Angles follow ``lut.models``: the light at polar angle θl and azimuth π, the
 viewer at (θv, φ), φ = 0 the mirror direction."""
@@ -162,12 +169,8 @@ def _retro_toon(closure, theta_l, theta_v, phi):
     bump map correction on, its default)."""
     cos_lv = -np.sin(theta_l) * np.sin(theta_v) * np.cos(phi) + np.cos(theta_l) * np.cos(theta_v)
     ramp = _toon(np.arccos(np.clip(cos_lv, 0.0, 1.0)), closure.size, closure.smooth)
-    cos_v = np.clip(np.cos(theta_v), 1e-6, 1.0)
-    cos_l = np.clip(np.cos(theta_l), 1e-6, 1.0)
-    alpha2 = np.clip(0.125 * (1.0 / cos_v**2 - 1.0), 0.0, 1.0)
-    shadow = 2.0 / (1.0 + np.sqrt(1.0 + alpha2 * (1.0 / cos_l**2 - 1.0)))
     up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2) & (cos_lv > 0)
-    return np.where(up, ramp * shadow, 0.0)
+    return np.where(up, ramp * bump_shadowing(theta_l, theta_v), 0.0)
 
 
 def _half_vector(theta_l, theta_v, phi):
@@ -336,7 +339,28 @@ def _phong_ramp_parts(closure, theta_l, theta_v, phi):
     return p, np.where(up, p * (e + 2.0) / (2.0 * np.pi) * np.cos(theta_l), 0.0)
 
 
-_RAMP_PARTS = {"diffuse_ramp": _diffuse_ramp_parts, "phong_ramp": _phong_ramp_parts}
+def bump_shadowing(theta_l, theta_v):
+    """Cycles' bump shadowing term for a diffuse closure whose normal is the
+    view direction (Conty Estevez et al., "A Microfacet-Based Shadowing
+    Function to Solve the Bump Terminator Problem", Ray Tracing Gems, 2019,
+    ch. 12; Cycles' bump_shadowing_term): GGX's G1 at cos θl with
+    α² = tan²θv/8."""
+    cos_v = np.clip(np.cos(theta_v), 1e-6, 1.0)
+    cos_l = np.clip(np.cos(theta_l), 1e-6, 1.0)
+    alpha2 = np.clip(0.125 * (1.0 / cos_v**2 - 1.0), 0.0, 1.0)
+    return 2.0 / (1.0 + np.sqrt(1.0 + alpha2 * (1.0 / cos_l**2 - 1.0)))
+
+
+def _retro_ramp_parts(closure, theta_l, theta_v, phi):
+    """OSL's diffuse_ramp about the view direction as (ramp position,
+    factor): cos γ = l·v and the bump shadowing term over π, lights above
+    the surface with l·v > 0."""
+    cos_lv = -np.sin(theta_l) * np.sin(theta_v) * np.cos(phi) + np.cos(theta_l) * np.cos(theta_v)
+    up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2) & (cos_lv > 0)
+    return np.clip(cos_lv, 0.0, 1.0), np.where(up, bump_shadowing(theta_l, theta_v) / np.pi, 0.0)
+
+
+_RAMP_PARTS = {"diffuse_ramp": _diffuse_ramp_parts, "phong_ramp": _phong_ramp_parts, "retro_ramp": _retro_ramp_parts}
 
 
 def _ramp_knot(closure, theta_l, theta_v, phi):
@@ -363,11 +387,13 @@ def evaluate_all(closures, theta_l, theta_v, phi) -> np.ndarray:
     return out
 
 
-def ramp_closures(exponents=(1.0,)) -> list:
-    """The knots of one diffuse ramp and of a Phong ramp per exponent: the
-    signed corrections an OSL fit adds (``lut.render.fitting``)."""
+def ramp_closures(exponents=(1.0,), retro=False) -> list:
+    """The knots of one diffuse ramp, of a Phong ramp per exponent and
+    (``retro``) of a diffuse ramp about the view: the signed corrections an
+    OSL fit adds (``lut.render.fitting``)."""
     knots = [Closure("diffuse_ramp", knot=j) for j in range(RAMP_KNOTS)]
     knots += [Closure("phong_ramp", knot=j, exponent=float(e)) for e in exponents for j in range(RAMP_KNOTS)]
+    knots += [Closure("retro_ramp", knot=j) for j in range(RAMP_KNOTS)] if retro else []
     return knots
 
 
@@ -476,6 +502,7 @@ CLOSURE_KINDS = {
     ),
     "diffuse_ramp": ClosureKind(_ramp_knot, cost=0, osl=True),
     "phong_ramp": ClosureKind(_ramp_knot, cost=0, osl=True),
+    "retro_ramp": ClosureKind(_ramp_knot, cost=0, osl=True),
 }
 
 
