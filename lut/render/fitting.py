@@ -804,6 +804,11 @@ OSL_EXPONENTS = (1.0, 8.0)
 #: (``closures.ramp_closures``: for back-scattering paints, a smooth one of
 #: g -0.49 from 2.86% / 7.67% to 1.95% / 4.62% on the measure).
 OSL_RETRO = True
+#: The least share by which the ramp about the view must lower the type's
+#: shortfall (``shortfall``, on the OSL goals) to be kept: each ramp costs
+#: render time on every pixel (the OSL variant renders at about 4x its SVM
+#: group), and on rough types it buys a few hundredths of the error.
+OSL_RETRO_GAIN = 0.05
 #: Ridge of the ramp knots' least squares, relative to the mean diagonal of
 #: each view's Gram matrix: knots few rows reach (a Phong ramp's top knots
 #: at grazing views) stay near zero instead of following noise of the LUT.
@@ -844,18 +849,13 @@ def osl_check_views(columns: int) -> np.ndarray:
     return np.clip((np.arange(columns + 1) - 0.5) / (columns - 1), np.cos(OSL_CHECK_VIEW), 1.0)
 
 
-def nonnegative_factor(svm_closures, ramps, weights, knots, cos_cols, margin=0.0):
-    """The largest factor in [0, 1] per (column, tile, component), (N, T, C),
-    by which the ramps' correction (knots (Q, C, N, T) at the texture's
-    columns ``cos_cols``) can be scaled so that the component's radiance,
-    the SVM closures' (weights (K, C, N, T)) plus the ramps', is nowhere
-    negative at the lights ``OSL_CHECK_LIGHTS`` x ``OSL_CHECK_AZIMUTHS``
-    and about the mirror of the view (``OSL_CHECK_MIRROR``), at both edges
-    of each column's cell (``osl_check_views``: the column's weights are
-    read over the whole cell); ``margin``: the share of the SVM radiance
-    the ramps may take away at a checked point, at most."""
-    n_cols = len(cos_cols)
-    theta_v = np.arccos(osl_check_views(n_cols))[:, None]
+def osl_check_values(svm_closures, ramps, columns: int):
+    """The SVM closures' and the ramps' responses where the bound is checked
+    for a weights texture of ``columns`` columns: (V, R, K) and (V, R, Q) at
+    the views ``osl_check_views`` and, per view, the lights
+    ``OSL_CHECK_LIGHTS`` x ``OSL_CHECK_AZIMUTHS`` and those about its mirror
+    (``OSL_CHECK_MIRROR``)."""
+    theta_v = np.arccos(osl_check_views(columns))[:, None]
     tl, ph = (a.ravel() for a in np.meshgrid(OSL_CHECK_LIGHTS, OSL_CHECK_AZIMUTHS, indexing="ij"))
     near_l, near_ph = (a.ravel() for a in np.meshgrid(*OSL_CHECK_MIRROR, indexing="ij"))
     tl = np.concatenate(
@@ -863,8 +863,20 @@ def nonnegative_factor(svm_closures, ramps, weights, knots, cos_cols, margin=0.0
     )
     ph = np.broadcast_to(np.concatenate([ph, near_ph]), tl.shape)
     tv = np.broadcast_to(theta_v, tl.shape)
+    return tuple(closures.evaluate_all(c, tl, tv, ph) for c in (svm_closures, ramps))
 
-    svm_v, ramp_v = (closures.evaluate_all(c, tl, tv, ph) for c in (svm_closures, ramps))  # (V, R, K)
+
+def nonnegative_factor(values, weights, knots, margin=0.0):
+    """The largest factor in [0, 1] per (column, tile, component), (N, T, C),
+    by which the ramps' correction (knots (Q, C, N, T) at the weights
+    texture's N columns) can be scaled so that the component's radiance,
+    the SVM closures' (weights (K, C, N, T)) plus the ramps', is nowhere
+    negative where ``values`` (``osl_check_values``) were evaluated: at
+    both edges of each column's cell (``osl_check_views``: the column's
+    weights are read over the whole cell); ``margin``: the share of the SVM
+    radiance the ramps may take away at a checked point, at most."""
+    svm_v, ramp_v = values
+    n_cols = weights.shape[2]
     factor = np.ones((n_cols, weights.shape[3], weights.shape[1]))
     for edge in range(2):  # each column's cell, its lower and upper edge
         at = slice(edge, edge + n_cols)
@@ -897,8 +909,9 @@ def fit_osl(
 ) -> Fit:
     """The OSL variant of a Cycles fit ``base`` (``fit_lut``): its closures
     and weights unchanged, plus the knots of one diffuse ramp, one Phong
-    ramp per exponent and (``retro``) a diffuse ramp about the view
-    (``closures.ramp_closures``) with **signed** weights,
+    ramp per exponent and (``retro``) a diffuse ramp about the view, kept
+    where it lowers the shortfall by ``OSL_RETRO_GAIN`` and not fitted to
+    the facet term (``closures.ramp_closures``) with **signed** weights,
     fitted per view, tile and component to the residual radiance the SVM
     closures leave on the rows ``row_set`` (``ROW_SETS``) by ridge least
     squares (``ridge``, ``OSL_RIDGE``).
@@ -943,37 +956,53 @@ def fit_osl(
     lam = np.maximum(ridge * scale, 1e-12 * np.maximum(scale, 1e-300))
     system = gram + lam[:, None, None] * np.eye(len(ramps))
     system = np.broadcast_to(system[:, None, None], (*rhs.shape, len(ramps)))
+    dense = view_cosines(texture_views(views))
+    k_ = len(base.closures)
+    basis = list(base.closures) + ramps
+    model = model_radiance(lut)
+    goals = measure.goals("OSL", base.mirror)
+    values = osl_check_values(base.closures, ramps, len(dense)) if nonnegative else None
+    is_retro = np.array([c.kind == "retro_ramp" for c in ramps])
+
+    def variant(free):
+        """The bounded variant with the ramp knots ``free`` (a mask like
+        rhs) fitted and the others 0: (weights, whole, band, shortfall)."""
+        free = free.copy()
+        knots = _solve_free(system, rhs, free)  # (M, T, C, Q)
+        if nonnegative:
+            # The diffuse ramp's first knot is its value at the horizon, where
+            # the SVM closures fade as cos θl: it must not be negative.  Where
+            # the free solution makes it so, solve again with it held at 0.
+            free[..., 0] = False
+            knots = np.where(knots[..., :1] < 0, _solve_free(system, rhs, free), knots)
+        weights = resample_views(
+            np.concatenate([w_base, np.transpose(knots, (3, 2, 0, 1))], axis=0), cos_view, dense
+        )  # (K + Q, C, N, T): the weights texture's columns
+        if nonnegative:
+            # Non-negative radiance: scale each column's correction, per tile
+            # and component, by the largest factor <= 1 that keeps it so
+            # everywhere the column is read (a colour is a sum of components
+            # with non-negative amplitudes, so every colour is too).
+            factor = nonnegative_factor(values, weights[:k_], weights[k_:], margin=OSL_MARGIN)
+            weights[k_:] *= np.transpose(factor, (2, 0, 1))[None] * (1.0 - 1e-6)
+        whole, band = measure_grams(model, basis, dense, weights, _cycles, columns=True)
+        return weights, whole, band, shortfall(whole, band, goals)
+
     # The facet term is the interface's reflection about the mirror: the
     # ramp about the view (a retro-reflection lobe) is not fitted to it.
     free = np.ones(rhs.shape, dtype=bool)
-    free[:, :, COMPONENTS.index("facet"), :] = [c.kind != "retro_ramp" for c in ramps]
-    knots = _solve_free(system, rhs, free)  # (M, T, C, Q)
-    if nonnegative:
-        # The diffuse ramp's first knot is its value at the horizon, where
-        # the SVM closures fade as cos θl: it must not be negative.  Where
-        # the free solution makes it so, solve again with it held at 0.
-        free[..., 0] = False
-        knots = np.where(knots[..., :1] < 0, _solve_free(system, rhs, free), knots)
-    dense = view_cosines(texture_views(views))
-    weights = resample_views(
-        np.concatenate([w_base, np.transpose(knots, (3, 2, 0, 1))], axis=0), cos_view, dense
-    )  # (K + Q, C, N, T): the weights texture's columns
-    k_ = len(base.closures)
-    if nonnegative:
-        # Non-negative radiance: scale each column's correction, per tile and
-        # component, by the largest factor <= 1 that keeps it so everywhere
-        # the column is read (a colour is a sum of components with
-        # non-negative amplitudes, so every colour is non-negative too).
-        factor = nonnegative_factor(base.closures, ramps, weights[:k_], weights[k_:], dense, margin=OSL_MARGIN)
-        weights[k_:] *= np.transpose(factor, (2, 0, 1))[None] * (1.0 - 1e-6)
-    basis = list(base.closures) + ramps
-    model = model_radiance(lut)
-    whole, band = measure_grams(model, basis, dense, weights, _cycles, columns=True)
-    goals = measure.goals("OSL", base.mirror)
-    if base.weights.shape[3] > 1 or shortfall(whole, band, goals) >= shortfall(
+    free[:, :, COMPONENTS.index("facet"), :] = ~is_retro
+    weights, whole, band, short = variant(free)
+    if is_retro.any():
+        # The ramp about the view is a fourth ramp each pixel shades: kept
+        # where it brings the type nearer its goals by OSL_RETRO_GAIN.
+        without = variant(free & ~is_retro)
+        if short > (1.0 - OSL_RETRO_GAIN) * without[3]:
+            weights, whole, band, short = without
+    if base.weights.shape[3] > 1 or short >= shortfall(
         (base.residual, base.reference), (base.grazing_residual, base.grazing_reference), goals
     ):
-        weights[len(base.closures) :] = 0.0  # the ramps do not pay: the SVM fit as it is
+        weights[k_:] = 0.0  # the ramps do not pay: the SVM fit as it is
         whole, band = (base.residual, base.reference), (base.grazing_residual, base.grazing_reference)
     return dataclasses.replace(
         base,
