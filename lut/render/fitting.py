@@ -651,16 +651,18 @@ def model_radiance(lut):
     return _model_radiance(json.dumps(meta["type"], sort_keys=True), single, diffuse, smooth)
 
 
-def measure_grams(model, basis, cos_view, weights, evaluate, *, columns=False):
+def measure_grams(model, basis, cos_view, weights, evaluate, *, columns=False, values=None):
     """The fidelity measure's Gram matrices of a fit: (residual, reference)
     over the whole grid and over the grazing band, each (T, C, C), from the
     model's radiance ``model`` (``model_radiance``: points and (N, T, C)) and
     the closures ``basis`` with the weights the node group reads: those of
     ``texture_weights`` for weights fitted at ``cos_view``, or with
     ``columns`` the weights texture's own columns at ``cos_view``, read at
-    the column nearest to each view."""
+    the column nearest to each view; ``values``: the closures' responses at
+    the model's points (K, N), where already evaluated."""
     (tl, tv, ph), target = model
-    values = np.array([evaluate(c, tl, tv, ph) for c in basis]).reshape(len(basis), tl.size)  # (K, N); K may be 0
+    if values is None:
+        values = np.array([evaluate(c, tl, tv, ph) for c in basis]).reshape(len(basis), tl.size)  # (K, N); K may be 0
     if columns:
         read = weights[:, :, nearest_column(len(cos_view), np.cos(tv)), :]
     else:
@@ -866,24 +868,41 @@ def osl_check_values(svm_closures, ramps, columns: int):
     return tuple(closures.evaluate_all(c, tl, tv, ph) for c in (svm_closures, ramps))
 
 
-def nonnegative_factor(values, weights, knots, margin=0.0):
+def svm_check_radiance(values, weights):
+    """The SVM closures' radiance (weights (K, C, N, T) at the weights
+    texture's N columns) where ``values`` (``osl_check_values``) were
+    evaluated, for each column at its cell's lower and upper edge: two
+    arrays (N, R, T, C)."""
+    svm_v = values[0]
+    n_cols = weights.shape[2]
+    return [_per_column(svm_v[edge : edge + n_cols], weights) for edge in range(2)]
+
+
+def _per_column(values, weights):
+    """Σ_k values[n, r, k]·weights[k, c, n, t] as (N, R, T, C): a batched
+    matrix product per column n (numpy's einsum is several times slower
+    at these sizes)."""
+    k_, c_, n_, t_ = weights.shape
+    per = np.transpose(weights, (2, 0, 3, 1)).reshape(n_, k_, t_ * c_)
+    return np.matmul(values, per).reshape(n_, values.shape[1], t_, c_)
+
+
+def nonnegative_factor(values, svm, knots, margin=0.0):
     """The largest factor in [0, 1] per (column, tile, component), (N, T, C),
     by which the ramps' correction (knots (Q, C, N, T) at the weights
     texture's N columns) can be scaled so that the component's radiance,
-    the SVM closures' (weights (K, C, N, T)) plus the ramps', is nowhere
+    the SVM closures' (``svm_check_radiance``) plus the ramps', is nowhere
     negative where ``values`` (``osl_check_values``) were evaluated: at
     both edges of each column's cell (``osl_check_views``: the column's
     weights are read over the whole cell); ``margin``: the share of the SVM
     radiance the ramps may take away at a checked point, at most."""
-    svm_v, ramp_v = values
-    n_cols = weights.shape[2]
-    factor = np.ones((n_cols, weights.shape[3], weights.shape[1]))
+    ramp_v = values[1]
+    n_cols = knots.shape[2]
+    factor = np.ones((n_cols, knots.shape[3], knots.shape[1]))
     for edge in range(2):  # each column's cell, its lower and upper edge
-        at = slice(edge, edge + n_cols)
-        svm = np.einsum("nrk,kcnt->nrtc", svm_v[at], weights)
-        corr = np.einsum("nrq,qcnt->nrtc", ramp_v[at], knots)
+        corr = _per_column(ramp_v[edge : edge + n_cols], knots)
         with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = np.where(corr < 0, (1.0 - margin) * np.maximum(svm, 0.0) / -corr, np.inf)
+            ratio = np.where(corr < 0, (1.0 - margin) * np.maximum(svm[edge], 0.0) / -corr, np.inf)
         factor = np.minimum(factor, ratio.min(axis=1))
     return np.clip(factor, 0.0, 1.0)
 
@@ -962,6 +981,9 @@ def fit_osl(
     model = model_radiance(lut)
     goals = measure.goals("OSL", base.mirror)
     values = osl_check_values(base.closures, ramps, len(dense)) if nonnegative else None
+    svm_check = svm_check_radiance(values, resample_views(w_base, cos_view, dense)) if nonnegative else None
+    (tl_m, tv_m, ph_m), _ = model
+    at_model = closures.evaluate_all(basis, tl_m, tv_m, ph_m).T  # (K + Q, N): the measure's points
     is_retro = np.array([c.kind == "retro_ramp" for c in ramps])
 
     def variant(free):
@@ -983,9 +1005,9 @@ def fit_osl(
             # and component, by the largest factor <= 1 that keeps it so
             # everywhere the column is read (a colour is a sum of components
             # with non-negative amplitudes, so every colour is too).
-            factor = nonnegative_factor(values, weights[:k_], weights[k_:], margin=OSL_MARGIN)
+            factor = nonnegative_factor(values, svm_check, weights[k_:], margin=OSL_MARGIN)
             weights[k_:] *= np.transpose(factor, (2, 0, 1))[None] * (1.0 - 1e-6)
-        whole, band = measure_grams(model, basis, dense, weights, _cycles, columns=True)
+        whole, band = measure_grams(model, basis, dense, weights, _cycles, columns=True, values=at_model)
         return weights, whole, band, shortfall(whole, band, goals)
 
     # The facet term is the interface's reflection about the mirror: the
@@ -1085,9 +1107,9 @@ def _fit_rows(
     comps = lut.components(theta_l, tv, phi) * (np.cos(theta_l) * row_w)[..., None, None]  # (M, R, T, C)
     m_, r_, t_, c_ = comps.shape
     a = np.stack([evaluate(c, theta_l, tv, phi) for c in basis], axis=-1) * row_w[..., None]  # (M, R, K)
-    gram = np.einsum("mrk,mrl->mkl", a, a)
+    gram = np.matmul(np.swapaxes(a, 1, 2), a)  # (M, K, K); a batched product, faster than einsum here
     b = comps.reshape(m_, r_, t_ * c_)
-    rhs = np.einsum("mrk,mrp->mpk", a, b)
+    rhs = np.matmul(np.swapaxes(b, 1, 2), a)  # (M, P, K)
     norm = np.einsum("mrp,mrp->mp", b, b)
     # Views count by their share of the measure; views beyond its range
     # still get their weights but count less in the selection.
