@@ -448,7 +448,9 @@ def is_current(material, paint, *, directory=None, exact_metallic=None, **option
         for target in engine_targets():
             fit_file = lut.render.fitting.fit_path(path, target, exact, eevee_calibration(), eevee_mode())
             fitted = lut.render.fitting.read_fit(fit_file)
-            if target == "CYCLES" and settings.osl and not settings.osl_problem:
+            if target == "CYCLES" and settings.osl and settings.osl_problem:
+                return False  # the variant could not be built: a bake tries again (this Blender may have OSL)
+            if target == "CYCLES" and settings.osl:
                 # The Cycles group draws the OSL variant, where its ramps carry weight.
                 variant_file = lut.render.fitting.fit_path(path, target, exact, osl=True)
                 variant = lut.render.fitting.read_fit(variant_file)

@@ -155,7 +155,11 @@ def build_group(fit: fitting.Fit, weights_path, exact_metallic=None):
     try:
         _fill_group(group, fit, weights_path, exact_metallic)
     except Exception:  # e.g. no OSL compiler for the variant's Script node: leave no half-built group
+        images = {nd.image for nd in group.nodes if nd.type == "TEX_IMAGE" and nd.image}
         bpy.data.node_groups.remove(group)
+        for image in images:
+            if image.users == 0:  # loaded for this group alone
+                bpy.data.images.remove(image)
         if old is not None:
             old.name = name
         raise

@@ -36,6 +36,8 @@ def draw_settings(layout, material, scene=None):
         errors = api.fit_errors(material, variants=True)
         has_variant = api.OSL_VARIANT in errors  # a bake stores the variant only where its ramps carry weight
         offer = errors.pop(api.OSL_VARIANT, None) if not settings.osl else None
+        if settings.osl_problem:  # asked for but not built here: the SVM closures render
+            errors.pop(api.OSL_VARIANT, None)
         for target, fit in errors.items():
             layout.label(text=fit_error_text(target, fit), icon="ERROR" if fit.missed else "CHECKMARK")
             if target == "EEVEE" and fit.eevee_mode:

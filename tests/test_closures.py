@@ -416,6 +416,11 @@ def test_the_batched_spd_solver_is_numpys_solve():
     # factor does not exist) sends the whole batch to elimination.
     a[3] = [[1.0 if i == j else (2.0 if abs(i - j) == 1 else 0.0) for j in range(7)] for i in range(7)]
     np.testing.assert_allclose(solve_spd(a, b), np.linalg.solve(a, b[..., None])[..., 0], rtol=1e-9, atol=1e-11)
+    # Either way a right-hand side with more batch axes than its matrices broadcasts.
+    many = rng.normal(size=(2, 30, 7))
+    for mats in (a, np.abs(a[:1]) + 7.0 * np.eye(7)):  # elimination, and Cholesky
+        want = np.linalg.solve(np.broadcast_to(mats, (2, 30, 7, 7)), many[..., None])[..., 0]
+        np.testing.assert_allclose(solve_spd(mats, many), want, rtol=1e-9, atol=1e-11)
 
 
 @pytest.mark.parametrize("target", ["CYCLES", "EEVEE"])

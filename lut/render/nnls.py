@@ -46,8 +46,10 @@ def _eliminate(a, b):
     """``solve_spd`` by Gaussian elimination without pivoting, which is
     stable for symmetric positive definite matrices (Golub and Van Loan,
     sec. 4.2) and finishes on semi-definite ones."""
-    a = np.array(a, dtype=float)
-    x = np.array(np.broadcast_to(b, a.shape[:-1]), dtype=float)
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    batch = np.broadcast_shapes(a.shape[:-2], b.shape[:-1])
+    a = np.array(np.broadcast_to(a, (*batch, *a.shape[-2:])))
+    x = np.array(np.broadcast_to(b, (*batch, b.shape[-1])))
     n = a.shape[-1]
     for k in range(n - 1):
         factor = a[..., k + 1 :, k] / a[..., k, k, None]
