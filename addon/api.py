@@ -264,13 +264,19 @@ def fit_errors(material, *, variants=False) -> dict:
     )
     out = {}
     for target, f in fits.items():
-        if target == OSL_VARIANT and not (variants or (settings.osl and not settings.osl_problem)):
+        if target == OSL_VARIANT and not (variants or _renders_osl_group(settings)):
             continue
         whole, grazing = fitting.reported_errors(f, amps)
         kind = measure.goals(target, paint.slope == 0)  # an earlier release stored the whole goal alone
         goals = f.get("goals") or (f.get("goal", kind[0]), kind[1])
         out[target] = FitError(whole, float(goals[0]), grazing, float(goals[1]), **_drawn(target, f, whole))
     return out
+
+
+def _renders_osl_group(settings) -> bool:
+    """Whether a material's Cycles group is its OSL variant's: the setting
+    is on and the variant could be built here (no ``osl_problem``)."""
+    return settings.osl and not settings.osl_problem
 
 
 def _result_errors(result: render_bake.RenderBake, paint, osl=False) -> dict:
@@ -445,11 +451,11 @@ def is_current(material, paint, *, directory=None, exact_metallic=None, **option
         table = lut.load_lut(path)
         if not path.stem.endswith(table.key[:24]):  # another type's LUT renamed onto this one's name
             return False
+        if settings.osl and settings.osl_problem:
+            return False  # the OSL variant could not be built: a bake tries again (this Blender may have OSL)
         for target in engine_targets():
             fit_file = lut.render.fitting.fit_path(path, target, exact, eevee_calibration(), eevee_mode())
             fitted = lut.render.fitting.read_fit(fit_file)
-            if target == "CYCLES" and settings.osl and settings.osl_problem:
-                return False  # the variant could not be built: a bake tries again (this Blender may have OSL)
             if target == "CYCLES" and settings.osl:
                 # The Cycles group draws the OSL variant, where its ramps carry weight.
                 variant_file = lut.render.fitting.fit_path(path, target, exact, osl=True)
@@ -495,8 +501,7 @@ def bake_materials(used, force=False, *, directory=None, exact_metallic=None, **
                 status[material.name] = _status("cached", errors, key)
                 continue
             result = bake_material(material, directory=directory, force=force, exact_metallic=exact_metallic, **options)
-            settings = material.paint_lut
-            errors = _result_errors(result, paint, settings.osl and not settings.osl_problem)
+            errors = _result_errors(result, paint, _renders_osl_group(material.paint_lut))
             status[material.name] = _status("baked", errors, result.lut_path.stem.split("-")[-1])
         except (ValueError, OSError, RuntimeError, TypeError, KeyError) as exc:
             status[material.name] = BakeStatus("failed", str(exc) or type(exc).__name__)

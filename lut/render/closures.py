@@ -167,7 +167,7 @@ def _retro_toon(closure, theta_l, theta_v, phi):
     Terminator Problem", Ray Tracing Gems, 2019, ch. 12): GGX's G1 at cos θl
     with α² = tan²θv/8 (Cycles' bump_shadowing_term, with the material's
     bump map correction on, its default)."""
-    cos_lv = -np.sin(theta_l) * np.sin(theta_v) * np.cos(phi) + np.cos(theta_l) * np.cos(theta_v)
+    cos_lv = cos_light_view(theta_l, theta_v, phi)
     ramp = _toon(np.arccos(np.clip(cos_lv, 0.0, 1.0)), closure.size, closure.smooth)
     up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2) & (cos_lv > 0)
     return np.where(up, ramp * bump_shadowing(theta_l, theta_v), 0.0)
@@ -244,11 +244,15 @@ def _ggx(closure, theta_l, theta_v, phi):
     return lobe * 0.5 * (np.abs(rs) ** 2 + np.abs(rp) ** 2)
 
 
-def light_view_angle(theta_l, theta_v, phi):
-    """The angle γ between the light (-sin θl, 0, cos θl) and the view
+def cos_light_view(theta_l, theta_v, phi):
+    """cos γ = l·v of the light (-sin θl, 0, cos θl) and the view
     (sin θv cos φ, sin θv sin φ, cos θv)."""
-    cos_lv = -np.sin(theta_l) * np.sin(theta_v) * np.cos(phi) + np.cos(theta_l) * np.cos(theta_v)
-    return np.arccos(np.clip(cos_lv, -1.0, 1.0))
+    return -np.sin(theta_l) * np.sin(theta_v) * np.cos(phi) + np.cos(theta_l) * np.cos(theta_v)
+
+
+def light_view_angle(theta_l, theta_v, phi):
+    """The angle γ between the light and the view (``cos_light_view``)."""
+    return np.arccos(np.clip(cos_light_view(theta_l, theta_v, phi), -1.0, 1.0))
 
 
 def _retro_glossy(closure, theta_l, theta_v, phi):
@@ -355,7 +359,7 @@ def _retro_ramp_parts(closure, theta_l, theta_v, phi):
     """OSL's diffuse_ramp about the view direction as (ramp position,
     factor): cos γ = l·v and the bump shadowing term over π, lights above
     the surface with l·v > 0."""
-    cos_lv = -np.sin(theta_l) * np.sin(theta_v) * np.cos(phi) + np.cos(theta_l) * np.cos(theta_v)
+    cos_lv = cos_light_view(theta_l, theta_v, phi)
     up = (theta_l < np.pi / 2) & (theta_v < np.pi / 2) & (cos_lv > 0)
     return np.clip(cos_lv, 0.0, 1.0), np.where(up, bump_shadowing(theta_l, theta_v) / np.pi, 0.0)
 

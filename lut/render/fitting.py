@@ -495,20 +495,9 @@ def view_measure(theta_v):
 def _nnls_fit(gram, rhs, norm, idx, upper, start=None):
     """Per-view NNLS weights on closures ``idx``: (x (M, s), relative squared
     error).  ``start`` (M, s): a warm start (``nnls.nnls_gram_batch``), the
-    weights of the same closures but the last."""
-    idx = list(idx)
-    sub = gram[:, idx][:, :, idx]  # (M, s, s)
-    g = rhs[:, idx]
-    scale = np.maximum(np.abs(np.diagonal(sub, axis1=-2, axis2=-1)).max(axis=-1), 1e-300)
-    # Unconstrained solutions first (all views at once); NNLS only where a
-    # weight leaves its bounds.
-    x = solve_spd(sub + 1e-13 * scale[:, None, None] * np.eye(len(idx)), g)
-    bad = (np.any(x < 0, axis=1) | np.any(x > upper, axis=1)) & (norm[:, 0] > 0)
-    if bad.any():
-        x[bad] = nnls_gram_batch(sub[bad], g[bad], upper=upper, start=None if start is None else start[bad])
-    x[norm[:, 0] == 0] = 0.0
-    err = norm[:, 0] - 2 * np.sum(x * g, axis=1) + np.einsum("ms,mst,mt->m", x, sub, x)
-    return x, float(_relative(np.maximum(err, 0.0), norm))
+    weights of the same closures but the last.  ``_nnls_fits`` of one target."""
+    x, rel = _nnls_fits(gram, rhs[:, None], norm[:, None], idx, upper, None if start is None else start[:, None])
+    return x[:, 0], rel[0]
 
 
 def _nnls_fits(gram, rhs, norm, idx, upper, start=None):
@@ -522,6 +511,8 @@ def _nnls_fits(gram, rhs, norm, idx, upper, start=None):
     g = rhs[:, :, idx].reshape(m_ * p_, len(idx))
     n0 = norm[:, :, 0].reshape(-1)
     scale = np.maximum(np.abs(np.diagonal(sub, axis1=-2, axis2=-1)).max(axis=-1), 1e-300)
+    # Unconstrained solutions first (all problems at once); NNLS only where
+    # a weight leaves its bounds.
     x = solve_spd(sub + 1e-13 * scale[:, None, None] * np.eye(len(idx)), g)
     bad = (np.any(x < 0, axis=1) | np.any(x > upper, axis=1)) & (n0 > 0)
     if bad.any():
@@ -880,9 +871,9 @@ def svm_check_radiance(values, weights):
 
 
 def _per_column(values, weights):
-    """Σ_k values[n, r, k]·weights[k, c, n, t] as (N, R, T, C): a batched
-    matrix product per column n (numpy's einsum is several times slower
-    at these sizes)."""
+    """Σ_k values[n, r, k]·weights[k, c, n, t] as (N, R, T, C), N views or
+    texture columns: a batched matrix product per n (numpy's einsum is
+    several times slower at these sizes)."""
     k_, c_, n_, t_ = weights.shape
     per = np.transpose(weights, (2, 0, 3, 1)).reshape(n_, k_, t_ * c_)
     return np.matmul(values, per).reshape(n_, values.shape[1], t_, c_)
@@ -943,10 +934,10 @@ def fit_osl(
     (SVM closures plus ramps) is non-negative over the hemisphere of lights
     at every view the column is read at (``nonnegative_factor``); a
     colour's radiance is a sum of components with non-negative amplitudes,
-    so every colour of the type is non-negative there too.  The ramps are kept only where they
-    bring the fit nearer its goals on the measure (``shortfall`` against the
-    OSL goals, ``measure.GOALS["OSL"]``); otherwise the variant is ``base``
-    with zero ramps.  Where OSL is off, the add-on renders ``base``'s
+    so every colour of the type is non-negative there too.  The ramps are
+    kept only where they bring the fit nearer its goals on the measure
+    (``shortfall`` against the OSL goals, ``measure.GOALS["OSL"]``);
+    otherwise the variant is ``base`` with zero ramps.  Where OSL is off, the add-on renders ``base``'s
     closures alone: exactly the SVM fit.  A dispersive type (a weight per
     channel: several tiles) keeps zero ramps: the ramps' weights texture
     packs three knots into one texel's channels (``texels``)."""
@@ -973,7 +964,7 @@ def fit_osl(
         )
     theta_l, phi, row_w = _rows(validate_row_set(row_set), theta_v, grid)
     tv = np.broadcast_to(theta_v[:, None], theta_l.shape)
-    drawn = np.einsum("mrk,kcmt->mrtc", closures.evaluate_all(base.closures, theta_l, tv, phi), w_base)
+    drawn = _per_column(closures.evaluate_all(base.closures, theta_l, tv, phi), w_base)  # (M, R, T, C)
     ramp = closures.evaluate_all(ramps, theta_l, tv, phi)  # (M, R, Q)
     target = lut.components(theta_l, tv, phi) * np.cos(theta_l)[..., None, None]  # (M, R, T, C)
     aw = ramp * row_w[..., None]
