@@ -464,7 +464,7 @@ def is_current(material, paint, *, directory=None, exact_metallic=None, **option
                     return False
                 if variant.draws_ramps:
                     fit_file, fitted = variant_file, variant
-            if fitted.lut_key != table.key or fitted.target != target:
+            if fitted.lut_key != table.key or fitted.target != target or fitted.stale_goals:
                 return False
             node = nodes.group_of(material, target)
             if node is None or not nodes.is_paint_group(node.node_tree):

@@ -162,3 +162,26 @@ def test_the_two_modes_have_their_own_weights_files(tmp_path):
     )
     assert again.computed == []
     assert len(again.fits["EEVEE"].closures) < len(converged.fits["EEVEE"].closures)
+
+
+def test_an_eevee_fit_chosen_against_other_goals_is_fitted_again(tmp_path):
+    """An EEVEE fit's file records the goals its closures were chosen
+    against (they decide how many and, in the Converged mode, whether the
+    wider fit is kept): a cached file chosen against other goals, or written
+    before files recorded them, is fitted again; the Cycles fit beside it is
+    kept."""
+    import dataclasses
+
+    paint = bench.random_paints(24)[2][1]
+    first = render_bake.bake_for_render(paint, tmp_path, eevee_calibration=CALIBRATION, eevee_mode="CONVERGED")
+    fitted = fitting.read_fit(first.fit_paths["EEVEE"])
+    assert fitted.chosen_for == measure.goals("EEVEE", smooth=False) and not fitted.stale_goals
+    assert fitting.read_fit(first.fit_paths["CYCLES"]).chosen_for is None
+    for chosen_for in (None, (0.08, 0.16)):  # an earlier release's file; other goals
+        fitting.write_fit(dataclasses.replace(fitted, chosen_for=chosen_for), first.fit_paths["EEVEE"])
+        assert fitting.read_fit(first.fit_paths["EEVEE"]).stale_goals
+        again = render_bake.bake_for_render(paint, tmp_path, eevee_calibration=CALIBRATION, eevee_mode="CONVERGED")
+        assert again.computed == ["EEVEE"]
+        assert not fitting.read_fit(first.fit_paths["EEVEE"]).stale_goals
+    cached = render_bake.bake_for_render(paint, tmp_path, eevee_calibration=CALIBRATION, eevee_mode="CONVERGED")
+    assert cached.computed == []

@@ -212,6 +212,20 @@ class Fit:
     #: An OSL variant's: the ``content_key`` of the SVM fit it was made
     #: from (a cached variant of another Cycles fit is stale).
     base_key: str = ""
+    #: An EEVEE fit's: the (whole, grazing band) goals its closures were
+    #: chosen against (how many, which mode's); a cached EEVEE fit chosen
+    #: against other goals is fitted again (``stale_goals``).
+    chosen_for: tuple | None = None
+
+    @property
+    def stale_goals(self) -> bool:
+        """Whether an EEVEE fit's closures were chosen against goals other
+        than today's (``measure.GOALS``; a fit written before its file
+        recorded them was chosen against earlier goals).  Cycles' goals
+        are those of every fit this format has written."""
+        if self.target != "EEVEE":
+            return False
+        return self.chosen_for is None or tuple(self.chosen_for) != tuple(self.goals)
 
     @property
     def sums_exactly(self) -> bool:
@@ -324,6 +338,7 @@ class Fit:
             "calibration": list(self.calibration) if self.calibration else None,
             "eevee_mode": self.eevee_mode,
             **({"base_key": self.base_key} if self.base_key else {}),
+            **({"chosen_for": list(self.chosen_for)} if self.chosen_for is not None else {}),
         }
 
 
@@ -785,6 +800,7 @@ def fit_lut(
         grazing_residual=band[0],
         grazing_reference=band[1],
         eevee_mode=eevee_mode,
+        chosen_for=measure.goals(target, float(type_dict["slope"]) == 0.0) if target == "EEVEE" else None,
     )
 
 
@@ -1334,6 +1350,7 @@ def read_fit(path) -> Fit:
             grazing_reference=np.array(h["grazing_reference"], dtype=float),
             eevee_mode=validate_eevee_mode(h.get("eevee_mode", "EXACT")),
             base_key=h.get("base_key", ""),
+            chosen_for=tuple(float(g) for g in h["chosen_for"]) if h.get("chosen_for") is not None else None,
         )
     except (KeyError, TypeError, ValueError, IndexError) as exc:
         if isinstance(exc, lutfile.LUTError):
