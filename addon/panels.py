@@ -42,6 +42,8 @@ def draw_settings(layout, material, scene=None):
             layout.label(text=fit_error_text(target, fit), icon="ERROR" if fit.missed else "CHECKMARK")
             if target == "EEVEE" and fit.eevee_mode:
                 layout.label(text=eevee_text(fit, api.eevee_mode(scene)), icon="INFO")
+            if target == "EEVEE" and fit.missed:
+                layout.label(text=EEVEE_LIMIT, icon="INFO")
         # Cycles' OSL variant: offered where the SVM fit misses its goals.
         if settings.osl or (offer is not None and errors.get("CYCLES") is not None and errors["CYCLES"].missed):
             layout.prop(settings, "osl")
@@ -67,6 +69,10 @@ def eevee_text(fit, scene_mode: str) -> str:
     if scene_mode != fit.eevee_mode:
         text += f"; the scene asks {scene_mode.title()}: bake to apply"
     return text
+
+
+#: The panel's line where EEVEE misses its goal: why, and where to look instead.
+EEVEE_LIMIT = "EEVEE draws every lobe as GGX and diffuse light as Lambert: Cycles shows this paint as fitted"
 
 
 def offer_text(fit) -> str:

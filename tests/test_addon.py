@@ -229,6 +229,9 @@ def test_the_panel_and_the_status_show_both_figures(material, lut_dir):
     panels.draw_settings(layout, material)
     lines = [text for text, _ in layout.labels if "fit error" in text]
     assert len(lines) == 2 and all("grazing light" in text for text in lines)
+    # Where EEVEE misses its goal the panel says why (and only there).
+    misses = api.fit_errors(material)["EEVEE"].missed
+    assert (panels.EEVEE_LIMIT in [text for text, _ in layout.labels]) == misses
 
 
 def test_glossy_black_bakes_and_renders_only_its_mirror(material, lut_dir):
