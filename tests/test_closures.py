@@ -428,14 +428,20 @@ def test_a_fits_radiance_is_what_its_reported_error_measures(tmp_path, target):
     """``Fit.radiance`` (what the node group renders, by the target's closure
     responses) against the model on the measure's grid gives the error the
     fit reports, whole and over the grazing band, for a colour the fit was
-    not made at."""
+    not made at.  The reported error is that of full-float closure colours
+    (a quadratic form in the colour); EEVEE's G-buffer truncation of them
+    (``eevee.stored_colour``) moves this paint's measure by under 1.5%
+    (measured: 0.66%, grazing 1.01%)."""
     paint = lut.Paint(n=1.55, rho=(0.6, 0.3, 0.05), single=0.1, g=0.3, slope=0.3, distribution="exponential")
     table = baking.load_lut(baking.bake(paint, tmp_path))
     fit = fitting.fit_lut(table, target, calibration=(5, 0) if target == "EEVEE" else None)
     amps = table.amplitudes(paint)
     tl, tv, ph = measure.points(smooth=False)
     model = paint.brdf(tl, tv, ph) * np.cos(tl)[:, None]
-    whole, grazing = measure.errors(fit.radiance(amps, tl, tv, ph), model, tl)
+    whole, grazing = measure.errors(fit.radiance(amps, tl, tv, ph, rounding="none"), model, tl)
+    if target == "EEVEE":
+        stored = measure.errors(fit.radiance(amps, tl, tv, ph), model, tl)
+        assert abs(stored[0] - whole) < 0.015 and abs(stored[1] - grazing) < 0.015, (stored, whole, grazing)
     assert whole == pytest.approx(fit.error(amps), rel=0.03, abs=0.002)
     assert grazing == pytest.approx(fit.grazing_error(amps), rel=0.03, abs=0.002)
     assert fit.radiance(amps, tl[:5], tv[:5], ph[:5]).shape == (5, 3)

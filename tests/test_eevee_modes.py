@@ -185,3 +185,49 @@ def test_an_eevee_fit_chosen_against_other_goals_is_fitted_again(tmp_path):
         assert not fitting.read_fit(first.fit_paths["EEVEE"]).stale_goals
     cached = render_bake.bake_for_render(paint, tmp_path, eevee_calibration=CALIBRATION, eevee_mode="CONVERGED")
     assert cached.computed == []
+
+
+def test_a_closure_colour_is_stored_as_eevees_g_buffer_keeps_it():
+    """``stored_colour`` against what EEVEE renders (Mesa's OpenGL, docs/eevee.md,
+    Dark colours): a white Lambert scaled to these colours renders these times
+    the colour, and colours above 1 share an exponent (steps of 2/1023 up to
+    2, clamped at 8)."""
+    colours = np.array([0.5, 0.1, 0.05, 0.03, 0.02, 0.01, 0.005])
+    measured = np.array([1.001, 0.997, 0.997, 0.977, 0.977, 0.977, 0.977])
+    kept = eevee.stored_colour(colours[:, None] * np.ones(3))[:, 0] / colours
+    assert np.allclose(kept, measured, atol=0.0025), kept
+    assert eevee.stored_colour([[1.5, 0.001, 0.0]])[0] == pytest.approx(
+        [767 * 2 / 1023, 0.0, 0.0]
+    )  # 0.75 · 1023 = 767.25
+    assert eevee.stored_colour([[9.0, 9.0, 9.0]])[0] == pytest.approx([8.0, 8.0, 8.0])
+    assert np.allclose(eevee.stored_colour(colours[:, None] * np.ones(3), "nearest")[:, 0], colours, rtol=0.1)
+    with pytest.raises(ValueError, match="colour rounding 'up'"):
+        eevee.stored_colour([[0.5, 0.5, 0.5]], "up")
+
+
+def test_the_predicted_render_keeps_closure_colours_as_eevee_does(random_set):
+    """``Fit.radiance`` of an EEVEE fit: with full floats the plain sum of the
+    closures (the mean of ``closure_select``'s picks is the sum); with the
+    G-buffer's truncation darker, by at most one step of each closure's
+    stored colour (a pick of chance p is stored as C/p: p times a step of
+    2^e/1023, below max(1, 2C)/1023); and darker where it is dark."""
+    darkest = []
+    for paint, table, exact, converged in random_set[:10]:
+        amps = table.amplitudes(paint)
+        tl, tv, ph = (a[::53] for a in measure.points(exact.mirror))
+        for fit in (exact, converged):
+            values = np.array([eevee.evaluate(c, tl, tv, ph, CALIBRATION) for c in fit.closures])
+            w = fit.weights[:, :, fitting.nearest_column(len(fit.cos_view), np.cos(tv)), :]
+            if w.shape[3] == 3:
+                colours = np.einsum("kcnh,hc->knh", w, amps)
+            else:
+                colours = np.einsum("kcn,hc->knh", w[..., 0], amps)
+            plain = np.einsum("kn,knh->nh", values, colours)
+            assert np.allclose(fit.radiance(amps, tl, tv, ph, rounding="none"), plain, rtol=1e-9, atol=1e-12)
+            kept = fit.radiance(amps, tl, tv, ph)
+            step = np.maximum(1.0, 2.0 * colours.max(axis=(1, 2)))[:, None] / 1023
+            assert np.all(kept <= plain + 1e-12)
+            assert np.all(plain - kept <= (values * step).sum(axis=0)[:, None] + 1e-12)
+            darkest.append((float(plain.mean()), 1.0 - float(kept.sum() / plain.sum())))
+    darkest.sort()
+    assert max(loss for _, loss in darkest[:4]) > max(loss for _, loss in darkest[-4:]), darkest

@@ -375,6 +375,100 @@ def _selection(closures, colours, facet, mirror_n, values):
     return np.array(contributions).reshape(-1, n_points, 3), np.array(weights).reshape(-1, n_points)
 
 
+#: Bits of each channel of a closure colour in EEVEE's G-buffer
+#: (``gbuffer_closure_color_pack`` in EEVEE's GLSL, Blender 4.2-5.2: a
+#: 10_10_10_2 unsigned normalised texel, the 2 bits a shared exponent).
+COLOUR_BITS = 10
+
+#: How a closure colour is rounded to the G-buffer's steps
+#: (``COLOUR_ROUNDINGS``).  OpenGL leaves it to the implementation; Mesa's
+#: software OpenGL, where this project's renders are checked, truncates:
+#: white closures scaled to colours 0.005-0.1 render 0.977-0.997 times the
+#: weight-1 render, floor(c·1023)/(c·1023) to three digits (docs/eevee.md,
+#: Dark colours).  A GPU that rounds to the nearest step loses nothing on
+#: average.
+COLOUR_ROUNDING = "floor"
+COLOUR_ROUNDINGS = {"floor": np.floor, "nearest": np.rint, "none": None}
+
+
+def validate_rounding(rounding: str) -> str:
+    """``rounding`` if it is one of ``COLOUR_ROUNDINGS``, else ValueError."""
+    if rounding not in COLOUR_ROUNDINGS:
+        raise ValueError(f"colour rounding {rounding!r} is not one of {sorted(COLOUR_ROUNDINGS)}")
+    return rounding
+
+
+def stored_colour(colour, rounding: str = COLOUR_ROUNDING):
+    """A closure colour (..., 3) as EEVEE's G-buffer keeps it: divided by
+    2^e, e = 0 for a largest channel up to 1, 1 up to 2, 2 up to 4, else 3
+    (clamped at 8), each channel then on steps of 1/(2^COLOUR_BITS - 1)
+    (``gbuffer_closure_color_pack``), rounded as ``rounding`` says.
+    Negative channels (not in an EEVEE fit) are kept at 0."""
+    step = COLOUR_ROUNDINGS[validate_rounding(rounding)]
+    c = np.maximum(np.asarray(colour, dtype=float), 0.0)
+    if step is None:
+        return c
+    top = c.max(axis=-1, keepdims=True)
+    scale = np.where(top > 4.0, 8.0, np.where(top > 2.0, 4.0, np.where(top > 1.0, 2.0, 1.0)))
+    levels = 2**COLOUR_BITS - 1
+    # A hair above each exact step, so a colour the node group computes as
+    # k/1023 in floats does not fall to the step below it.
+    return step(np.clip(c / scale, 0.0, 1.0) * levels * (1.0 + 1e-7)) / levels * scale
+
+
+def mean_radiance(closures, colours, values, mirror_n, facet, rounding: str = COLOUR_ROUNDING):
+    """The RGB radiance (N, 3) of EEVEE's render averaged over samples, with
+    each closure colour as the G-buffer keeps it (``stored_colour``).
+    ``colours`` (K, N, 3), ``values`` (K, N): the closures' colours and
+    responses; ``mirror_n``: a smooth type's IOR (its mirror shares a bin)
+    or None; ``facet``: the mean facet amplitude (the mirror's weight).
+
+    Where EEVEE sums the closures exactly, the diffuse ones of a bin are one
+    layer (their colours added, then stored) and each reflection closure is
+    stored alone.  Otherwise ``closure_select`` keeps closure k of a bin with
+    probability p_k and stores its colour divided by p_k, so the mean is
+    Σ p_k·stored(C_k/p_k)·value_k.  A grey lobe's colour is its Mix Shader
+    factor (``_selection``)."""
+    closures = list(closures)
+    values = np.asarray(values, dtype=float)
+    colours = np.asarray(colours, dtype=float)
+    n_points = values.shape[1]
+    mirror = mirror_n is not None
+    grey = [c.grey for c in closures]
+    # What the G-buffer stores of each closure: a grey lobe's factor (one
+    # value for every channel, its Mix Shader's), else its colour.
+    tints = np.array(
+        [
+            np.clip(colours[k].mean(axis=-1), 0.0, 1.0)[:, None] * np.ones(3) if grey[k] else colours[k]
+            for k in range(len(closures))
+        ]
+    ).reshape(len(closures), n_points, 3)
+
+    def kept(k, tint, p):
+        """Closure k's colour once its tint (kept with probability p) is stored."""
+        ratio = np.divide(p * stored_colour(tint / p, rounding), tint, out=np.zeros_like(tint), where=tint > 0)
+        return np.where(tint > 0, ratio, 1.0) * colours[k]
+
+    out = np.zeros((n_points, 3))
+    if sums_exactly(closures, mirror):
+        diffuse = [k for k, c in enumerate(closures) if not is_reflection(c)]
+        if diffuse:  # one layer: the colours added, then stored
+            layer = tints[diffuse].sum(axis=0)
+            ratio = np.divide(stored_colour(layer, rounding), layer, out=np.ones_like(layer), where=layer > 0)
+            out += ratio * np.einsum("kn,knh->nh", values[diffuse], colours[diffuse])
+        for k in range(len(closures)):
+            if is_reflection(closures[k]):
+                out += kept(k, tints[k], np.ones((n_points, 1))) * values[k][:, None]
+        return out
+    _, select = _selection(closures, colours, facet, mirror_n, values)
+    which = np.array(bins(closures, mirror))
+    for k in range(len(closures)):
+        total = select[which == which[k]].sum(axis=0)
+        p = np.where(total > 0, select[k] / np.where(total > 0, total, 1.0), 0.0)[:, None]
+        out += np.where(p > 0, kept(k, tints[k], np.where(p > 0, p, 1.0)), 0.0) * values[k][:, None]
+    return out
+
+
 def bins(closures, mirror: bool) -> list:
     """The closure bin each closure (and a smooth type's mirror, last) falls
     in: 0 the diffuse one; reflection closures alternate between bins 2

@@ -295,20 +295,37 @@ class Fit:
         """The same over the grazing band (θl ≥ 60°)."""
         return reported_errors(self.grams(), amplitudes)[1]
 
-    def radiance(self, amplitudes, theta_l, theta_v, phi) -> np.ndarray:
+    def radiance(self, amplitudes, theta_l, theta_v, phi, rounding=None) -> np.ndarray:
         """The RGB radiance per unit irradiance, (N, 3), that the node group
         renders at geometries (θl, θv, φ) (1-D arrays) for a paint with these
         amplitudes: the closures as the target draws them (``evaluator_for``:
         EEVEE's measured responses for a calibrated fit) with the weights the
         texture gives (nearest view column); a smooth type's mirror (a
-        delta) is not included.  What ``error`` measures against the model."""
+        delta) is not included.  What ``error`` measures against the model.
+
+        For EEVEE, the mean over samples with each closure colour as its
+        G-buffer keeps it (``eevee.mean_radiance``), rounded as ``rounding``
+        says (``eevee.COLOUR_ROUNDINGS``; default ``eevee.COLOUR_ROUNDING``,
+        "none" for full floats).  ``error``, formed from the fit's Gram
+        matrices, is that of full floats."""
         tl, tv, ph = (np.ravel(np.asarray(a, dtype=float)) for a in (theta_l, theta_v, phi))
         evaluate = evaluator_for(self.target, self.calibration)
         values = np.array([evaluate(c, tl, tv, ph) for c in self.closures]).reshape(len(self.closures), tl.size)
-        comps = np.einsum("kn,kcnt->ntc", values, self.weights[:, :, nearest_column(len(self.cos_view), np.cos(tv)), :])
-        tiles = comps.shape[1]
-        amps = np.asarray(amplitudes, dtype=float)
-        return np.einsum("nkc,kc->nk", comps[:, [k if tiles == 3 else 0 for k in range(3)], :], amps)
+        weights = self.weights[:, :, nearest_column(len(self.cos_view), np.cos(tv)), :]  # (K, C, N, T)
+        amps = np.asarray(amplitudes, dtype=float)  # (3 channels, C)
+        if weights.shape[3] == 3:
+            colours = np.einsum("kcnh,hc->knh", weights, amps)
+        else:
+            colours = np.einsum("kcn,hc->knh", weights[..., 0], amps)
+        if self.target != "EEVEE":
+            return np.einsum("kn,knh->nh", values, colours)
+        from . import eevee
+
+        facet = float(np.mean(amps[:, 0]))
+        mirror_n = self.n if self.mirror else None
+        return eevee.mean_radiance(
+            self.closures, colours, values, mirror_n, facet, eevee.COLOUR_ROUNDING if rounding is None else rounding
+        )
 
     def grams(self) -> dict:
         """The Gram matrices the reported errors come from, as lists (what a
