@@ -218,10 +218,7 @@ def test_the_predicted_render_keeps_closure_colours_as_eevee_does(random_set):
         for fit in (exact, converged):
             values = np.array([eevee.evaluate(c, tl, tv, ph, CALIBRATION) for c in fit.closures])
             w = fit.weights[:, :, fitting.nearest_column(len(fit.cos_view), np.cos(tv)), :]
-            if w.shape[3] == 3:
-                colours = np.einsum("kcnh,hc->knh", w, amps)
-            else:
-                colours = np.einsum("kcn,hc->knh", w[..., 0], amps)
+            colours = fitting.closure_colours(w, amps)
             plain = np.einsum("kn,knh->nh", values, colours)
             assert np.allclose(fit.radiance(amps, tl, tv, ph, rounding="none"), plain, rtol=1e-9, atol=1e-12)
             kept = fit.radiance(amps, tl, tv, ph)

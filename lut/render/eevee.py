@@ -342,13 +342,9 @@ CONVERGENCE = 0.7
 def _colours(weights, cos_view, amplitudes, theta_v):
     """Σ_c a_c·w_kc: each closure's colour (K, N, 3) at views θv (N,) as
     the node group reads its weights."""
-    from .fitting import texture_weights
+    from .fitting import closure_colours, texture_weights
 
-    w = texture_weights(weights, cos_view, np.cos(theta_v))  # (K, C, N, T)
-    amps = np.asarray(amplitudes, dtype=float)  # (3 channels, C)
-    if w.shape[-1] == 1:
-        return np.einsum("kcn,hc->knh", w[..., 0], amps)
-    return np.einsum("kcnh,hc->knh", w, amps)
+    return closure_colours(texture_weights(weights, cos_view, np.cos(theta_v)), amplitudes)
 
 
 def _selection(closures, colours, facet, mirror_n, values):
@@ -446,8 +442,9 @@ def mean_radiance(closures, colours, values, mirror_n, facet, rounding: str = CO
 
     def kept(k, tint, p):
         """Closure k's colour once its tint (kept with probability p) is stored."""
-        ratio = np.divide(p * stored_colour(tint / p, rounding), tint, out=np.zeros_like(tint), where=tint > 0)
-        return np.where(tint > 0, ratio, 1.0) * colours[k]
+        return (
+            np.divide(p * stored_colour(tint / p, rounding), tint, out=np.ones_like(tint), where=tint > 0) * colours[k]
+        )
 
     out = np.zeros((n_points, 3))
     if sums_exactly(closures, mirror):

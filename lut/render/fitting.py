@@ -311,12 +311,8 @@ class Fit:
         tl, tv, ph = (np.ravel(np.asarray(a, dtype=float)) for a in (theta_l, theta_v, phi))
         evaluate = evaluator_for(self.target, self.calibration)
         values = np.array([evaluate(c, tl, tv, ph) for c in self.closures]).reshape(len(self.closures), tl.size)
-        weights = self.weights[:, :, nearest_column(len(self.cos_view), np.cos(tv)), :]  # (K, C, N, T)
         amps = np.asarray(amplitudes, dtype=float)  # (3 channels, C)
-        if weights.shape[3] == 3:
-            colours = np.einsum("kcnh,hc->knh", weights, amps)
-        else:
-            colours = np.einsum("kcn,hc->knh", weights[..., 0], amps)
+        colours = closure_colours(self.weights[:, :, nearest_column(len(self.cos_view), np.cos(tv)), :], amps)
         if self.target != "EEVEE":
             return np.einsum("kn,knh->nh", values, colours)
         from . import eevee
@@ -637,6 +633,16 @@ def nearest_column(columns: int, cos_v) -> np.ndarray:
     """The column of a weights texture of ``columns`` columns (cos θv =
     j/(columns - 1)) that a Closest lookup at view cosines ``cos_v`` reads."""
     return np.clip(np.rint(np.asarray(cos_v) * (columns - 1)).astype(int), 0, columns - 1)
+
+
+def closure_colours(weights, amplitudes) -> np.ndarray:
+    """Σ_c a_c·w_kc: each closure's colour (K, N, 3) from the weights it reads
+    (K, C, N, T: one tile for every channel, or one per channel) and a
+    paint's amplitudes (3 channels, C)."""
+    amps = np.asarray(amplitudes, dtype=float)
+    if weights.shape[-1] == 1:
+        return np.einsum("kcn,hc->knh", weights[..., 0], amps)
+    return np.einsum("kcnh,hc->knh", weights, amps)
 
 
 def texture_weights(weights, cos_view, cos_v):
