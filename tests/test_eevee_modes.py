@@ -106,7 +106,7 @@ def test_the_spread_is_the_variance_of_eevees_closure_selection(random_set):
     rng = np.random.default_rng(1)
     tl, tv, ph = (a[::97] for a in measure.points(fit.mirror))
     values = np.array([eevee.evaluate(c, tl, tv, ph, CALIBRATION) for c in fit.closures])
-    colours = eevee._colours(fit.weights, fit.cos_view, amps, tv)
+    colours = eevee._colours(fit.weights, fit.cos_view, amps, tv, columns=True)
     mirror_n = fit.n if fit.mirror else None
     contributions, select = eevee._selection(fit.closures, colours, float(amps[:, 0].mean()), mirror_n, values)
     which = np.array(eevee.bins(fit.closures, fit.mirror))

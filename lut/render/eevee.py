@@ -339,12 +339,15 @@ NOISE_FLOOR = 0.02
 CONVERGENCE = 0.7
 
 
-def _colours(weights, cos_view, amplitudes, theta_v):
+def _colours(weights, cos_view, amplitudes, theta_v, columns=False):
     """Σ_c a_c·w_kc: each closure's colour (K, N, 3) at views θv (N,) as
-    the node group reads its weights."""
-    from .fitting import closure_colours, texture_weights
+    the node group reads its weights: those of ``texture_weights`` for
+    weights fitted at ``cos_view``, or with ``columns`` the weights
+    texture's own columns at ``cos_view`` (a ``Fit``'s), read at the
+    column nearest to each view."""
+    from .fitting import closure_colours, read_weights
 
-    return closure_colours(texture_weights(weights, cos_view, np.cos(theta_v)), amplitudes)
+    return closure_colours(read_weights(weights, cos_view, np.cos(theta_v), columns), amplitudes)
 
 
 def _selection(closures, colours, facet, mirror_n, values):
@@ -481,9 +484,13 @@ def bins(closures, mirror: bool) -> list:
     return out
 
 
-def spread_of(closures, weights, cos_view, mirror, n, amplitudes, points, version, samples=1, values=None):
+def spread_of(
+    closures, weights, cos_view, mirror, n, amplitudes, points, version, samples=1, values=None, columns=False
+):
     """``spread`` of closures with weights (K, C, M, T) at view cosines
-    ``cos_view``; ``n``: the type's IOR (its mirror's), ``version``: the
+    ``cos_view`` (with ``columns``, the weights texture's own columns, as a
+    ``Fit`` holds them; else weights fitted there, which the texture
+    resamples); ``n``: the type's IOR (its mirror's), ``version``: the
     calibrated Blender line (None: Cycles' formulas); ``values``: the
     closures' responses at ``points`` (K, N), when computed already."""
     if sums_exactly(closures, mirror):
@@ -492,7 +499,7 @@ def spread_of(closures, weights, cos_view, mirror, n, amplitudes, points, versio
     if values is None:
         values = np.array([evaluate_closure(c, theta_l, theta_v, phi, version) for c in closures])
     values = np.asarray(values, dtype=float).reshape(len(closures), theta_l.size)
-    colours = _colours(weights, cos_view, amplitudes, theta_v)
+    colours = _colours(weights, cos_view, amplitudes, theta_v, columns)
     facet = float(np.mean(np.asarray(amplitudes, dtype=float)[:, 0]))
     contributions, select = _selection(closures, colours, facet, n if mirror else None, values)
     which = np.array(bins(closures, mirror))
@@ -530,7 +537,9 @@ def spread(fit, amplitudes, samples=1, points=None):
 
     points = measure.points(fit.mirror) if points is None else points
     version = tuple(fit.calibration) if fit.calibration else None
-    return spread_of(fit.closures, fit.weights, fit.cos_view, fit.mirror, fit.n, amplitudes, points, version, samples)
+    return spread_of(
+        fit.closures, fit.weights, fit.cos_view, fit.mirror, fit.n, amplitudes, points, version, samples, columns=True
+    )
 
 
 def evaluate_closure(closure, theta_l, theta_v, phi, version):

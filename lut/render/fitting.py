@@ -312,7 +312,7 @@ class Fit:
         evaluate = evaluator_for(self.target, self.calibration)
         values = np.array([evaluate(c, tl, tv, ph) for c in self.closures]).reshape(len(self.closures), tl.size)
         amps = np.asarray(amplitudes, dtype=float)  # (3 channels, C)
-        colours = closure_colours(self.weights[:, :, nearest_column(len(self.cos_view), np.cos(tv)), :], amps)
+        colours = closure_colours(read_weights(self.weights, self.cos_view, np.cos(tv), columns=True), amps)
         if self.target != "EEVEE":
             return np.einsum("kn,knh->nh", values, colours)
         from . import eevee
@@ -655,6 +655,17 @@ def texture_weights(weights, cos_view, cos_v):
     return texture[:, :, nearest_column(len(columns), cos_v), :]
 
 
+def read_weights(weights, cos_view, cos_v, columns=False):
+    """The weights (K, C, N, T) a node group reads at view cosines ``cos_v``
+    (N,): with ``columns``, ``weights`` are the weights texture's own
+    columns at ``cos_view`` (a ``Fit``'s) and the column nearest to each
+    view is read; else they are weights fitted at ``cos_view``, read as
+    ``texture_weights``."""
+    if columns:
+        return weights[:, :, nearest_column(len(cos_view), cos_v), :]
+    return texture_weights(weights, cos_view, cos_v)
+
+
 @functools.lru_cache(maxsize=4)
 def _model_radiance(type_json: str, single_nodes, diffuse_nodes, smooth: bool):
     """The paper's model at the measure's geometries (``measure.points``):
@@ -692,11 +703,7 @@ def measure_grams(model, basis, cos_view, weights, evaluate, *, columns=False, v
     (tl, tv, ph), target = model
     if values is None:
         values = np.array([evaluate(c, tl, tv, ph) for c in basis]).reshape(len(basis), tl.size)  # (K, N); K may be 0
-    if columns:
-        read = weights[:, :, nearest_column(len(cos_view), np.cos(tv)), :]
-    else:
-        read = texture_weights(weights, cos_view, np.cos(tv))
-    fitted = np.einsum("kn,kcnt->ntc", values, read)
+    fitted = np.einsum("kn,kcnt->ntc", values, read_weights(weights, cos_view, np.cos(tv), columns))
     r = fitted - target
     band = measure.grazing(tl)
 
