@@ -112,8 +112,8 @@ def test_eevee_renders_the_randomised_set_as_measured(randomised):
     # On the fidelity measure (no cos θl weight: grazing light in full) this
     # set's smooth paints measured 3.5%, 4.2% and 5.4% on Blender 5.0.
     assert np.median(smooth) <= 0.05, smooth
-    # Rough: median 14.6%, worst 42% on that measure (docs/fidelity.md: the
-    # EEVEE column is not re-rendered for the docs yet).
+    # Rough: median 14.6%, worst 42% on that measure (docs/fidelity.md has
+    # the whole randomised set's figures).
     assert np.median(rough) <= 0.16, rough
     assert max(smooth + rough) <= 0.45, smooth + rough
     for row in randomised:
