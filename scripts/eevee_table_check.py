@@ -42,17 +42,14 @@ def ratios(oracle, closure: Closure) -> list:
     """Rendered over tabled radiance of ``closure`` alone at ``GEOMETRIES``."""
     from scripts.calibrate_eevee import closure_shader
 
-    material = oracle.material(f"check-{closure.kind}-{closure.roughness:g}")
-    tree = material.node_tree
-    output = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeOutputMaterial")
-    tree.links.new(closure_shader(tree, closure, 1.0), output.inputs["Surface"])
-    out = []
-    for geometry in GEOMETRIES:
-        theta_l, theta_v, phi = np.radians(geometry)
-        rendered = float(np.mean(oracle.radiance(theta_l, theta_v, phi))) / oracle.irradiance
-        tabled = float(eevee.evaluate(closure, theta_l, theta_v, phi, CALIBRATION))
-        out.append(rendered / tabled if tabled > 0 else float("nan"))
-    return out
+    tree = oracle.material(f"check-{closure.kind}-{closure.roughness:g}").node_tree
+    tree.links.new(closure_shader(tree, closure, 1.0), tree.nodes["Material Output"].inputs["Surface"])
+    theta_l, theta_v, phi = np.radians(GEOMETRIES).T
+    tabled = eevee.evaluate(closure, theta_l, theta_v, phi, CALIBRATION)
+    # One render per geometry: every pixel of the plane sees the same one.
+    rendered = np.array([np.mean(oracle.radiance(*g)) for g in zip(theta_l, theta_v, phi, strict=True)])
+    rendered /= oracle.irradiance
+    return list(np.where(tabled > 0, rendered / np.where(tabled > 0, tabled, 1.0), np.nan))
 
 
 def main(argv=None) -> int:
