@@ -17,6 +17,9 @@ interpolation to the pixels (``lut.render.eevee.fit_table``), held near the
 binned ratio Σ EEVEE / Σ reference of each cell's pixels where few pixels
 reach it: binning alone is biased near a sharp lobe's mirror at grazing
 angles, where a cell's pixels are weighted toward its brighter side.
+Flat squares side by side (``PlaneScene``, one render per geometry) measure
+the grazing band (θl, θv 50-75°, |φ| ≤ 45°) exactly, where the spheres'
+pixels are those next to the silhouette; there they replace the spheres'.
 
 Run ``python scripts/calibrate_eevee.py`` with a Python whose ``bpy`` renders
 EEVEE; the tables of that Blender line (``bpy.app.version[:2]``) are added to
@@ -249,6 +252,108 @@ class SphereScene:
         return out
 
 
+class PlaneScene:
+    """Flat squares side by side on the plane z = 0, one closure each (white,
+    unit weight), a delta Sun, an orthographic camera, a black world: every
+    pixel of a square sees the same (θl, θv, φ), the geometry set as the
+    plane oracle sets it (``addon.scenes.Oracle``).  One render gives every
+    closure's radiance at one geometry, so grazing geometries, where a
+    sphere's pixels thin out toward its silhouette, are measured as densely
+    as any other."""
+
+    #: Pixels across the render, and the squares' side and spacing (scene
+    #: units): at θv = 75° a square spans 0.26 of its side, about 7 pixels.
+    SIZE, SIDE, PITCH = 640, 1.0, 1.4
+
+    def __init__(self, todo):
+        import bpy
+
+        from addon import scenes
+
+        columns = math.ceil(math.sqrt(len(todo)))
+        scene = scenes.new_scene(scenes.EEVEE, 1, (self.SIZE, self.SIZE))
+        scene.eevee.use_shadows = False
+        scene.eevee.use_raytracing = False
+        scene.eevee.clamp_surface_direct = 0.0
+        scene.render.filter_size = 0.0
+        scene.view_settings.view_transform = "Standard"
+        scene.render.image_settings.file_format = "OPEN_EXR"
+        scene.render.image_settings.color_depth = "32"
+        scenes.add_world(scene, 0.0, name="black")
+        half = self.SIDE / 2
+        self.centres = []
+        for i, closure in enumerate(todo):
+            x = (i % columns - (columns - 1) / 2) * self.PITCH
+            y = ((columns - 1) / 2 - i // columns) * self.PITCH
+            mesh = bpy.data.meshes.new(f"square{i}")
+            corners = [(x + sx * half, y + sy * half, 0.0) for sx, sy in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+            mesh.from_pydata(corners, [], [(0, 1, 2, 3)])
+            square = bpy.data.objects.new(f"square{i}", mesh)
+            scene.collection.objects.link(square)
+            mat = bpy.data.materials.new(f"p{i}")
+            if mat.node_tree is None:  # Blender 4.x
+                mat.use_nodes = True
+            tree = mat.node_tree
+            for node in list(tree.nodes):
+                tree.nodes.remove(node)
+            out = tree.nodes.new("ShaderNodeOutputMaterial")
+            tree.links.new(closure_shader(tree, closure), out.inputs["Surface"])
+            mesh.materials.append(mat)
+            self.centres.append((x, y))
+        # The frame turns with the view about its axis: it spans the grid's diagonal.
+        self.camera = scenes.add_camera(scene, ortho_scale=self.PITCH * columns * 1.5)
+        self.sun = scenes.add_sun(scene, energy=1.0, angle=0.0)
+        self.sun.data.use_shadow = False
+        self.scene = scene
+        self._path = os.path.join(tempfile.mkdtemp(prefix="eevee_planes"), "render.exr")
+
+    def render(self, theta_l, theta_v, phi):
+        """Each closure's radiance (red channel, unit irradiance) at one
+        geometry: the mean of the 3 x 3 pixels about its square's centre."""
+        import bpy
+        import OpenImageIO as oiio
+        from bpy_extras.object_utils import world_to_camera_view
+        from mathutils import Vector
+
+        self.sun.rotation_euler = (0.0, -theta_l, 0.0)
+        view = Vector((math.sin(theta_v) * math.cos(phi), math.sin(theta_v) * math.sin(phi), math.cos(theta_v)))
+        self.camera.location = 20.0 * view
+        self.camera.rotation_euler = view.to_track_quat("Z", "Y").to_euler()
+        bpy.context.view_layer.update()
+        self.scene.render.filepath = self._path
+        bpy.ops.render.render(write_still=True)
+        red = oiio.ImageBuf(self._path).get_pixels(oiio.FLOAT)[..., 0].astype(float)
+        out = []
+        for x, y in self.centres:
+            u, v, _ = world_to_camera_view(self.scene, self.camera, Vector((x, y, 0.0)))
+            col, row = int(u * self.SIZE), int((1.0 - v) * self.SIZE)
+            out.append(float(red[row - 1 : row + 2, col - 1 : col + 2].mean()))
+        return out
+
+
+#: Geometries the squares are rendered at (degrees): the grazing band where
+#: the spheres' tables were measured 15-25% off the plane oracle at the
+#: mirror (θl, θv 60-75°), on the tables' nodes and half-way in φ.
+PLANE_THETA = (50, 55, 60, 65, 70, 75)
+PLANE_PHI = (0, 7.5, 15, 22.5, 30, 45)
+
+
+def measure_planes(todo):
+    """Per closure of ``todo``: (θl, θv, φ, radiance) at the grazing
+    geometries ``PLANE_THETA`` x ``PLANE_THETA`` x ``PLANE_PHI``, from
+    one render of the squares per geometry."""
+    scene = PlaneScene(todo)
+    grid = [(a, b, c) for a in PLANE_THETA for b in PLANE_THETA for c in PLANE_PHI]
+    values = []
+    t0 = time.time()
+    for a, b, c in grid:
+        values.append(scene.render(*np.radians((a, b, c))))
+    print(f"{len(todo)} closures on squares, {len(grid)} renders, {time.time() - t0:.0f} s", flush=True)
+    angles = np.radians(np.array(grid, dtype=float)).T.astype(np.float32)
+    values = np.array(values, dtype=np.float32).T
+    return [(*angles, values[i]) for i in range(len(todo))]
+
+
 def geometry(normal, light, view=(0.0, 0.0, 1.0)):
     """(θl, θv, φ) of unit normals (N, 3) for a light and a view direction:
     φ the azimuth of the view from the mirror of the light's azimuth."""
@@ -288,15 +393,33 @@ def bin_ratios(samples, closure):
     return ratio, count
 
 
-def fitted_table(closure, sample):
-    """The table of ``closure`` from its pixels ``sample`` (θl, θv, φ,
-    radiance): the least-squares fit of ``lut.render.eevee.fit_table`` about
-    the binned ratios, pixels within 1° of the horizon left out as in
-    ``bin_ratios``."""
-    prior = eevee.fill(bin_ratios([sample], closure)[0])
+def fitted_table(closure, sample, planes=None):
+    """The table of ``closure`` from its sphere pixels ``sample`` (θl, θv, φ,
+    radiance) and its squares' geometries ``planes`` (the same, or None):
+    the least-squares fit of ``lut.render.eevee.fit_table`` about the binned
+    ratios of the spheres, pixels within 1° of the horizon left out as in
+    ``bin_ratios``.  Where the squares measure (their geometries' box,
+    half a cell beyond it), the spheres' pixels are left out: they are the
+    pixels next to the silhouette, which EEVEE shades unlike a flat surface
+    at the same angles (``scripts/eevee_table_check.py`` measured those
+    tables 15-25% off the plane oracle at the grazing mirror).  A square's
+    geometry counts as many pixels as the median cell the spheres reach."""
+    ratio, count = bin_ratios([sample], closure)
+    prior = eevee.fill(ratio)
     tl, tv, ph, value = (np.asarray(a, dtype=float) for a in sample)
     keep = (tl < np.radians(89.0)) & (tv < np.radians(89.0))
-    return eevee.fit_table(closure, tl[keep], tv[keep], ph[keep], value[keep], prior)
+    tl, tv, ph, value = tl[keep], tv[keep], ph[keep], value[keep]
+    weight = np.ones(tl.size)
+    if planes is not None:
+        lo, hi = np.radians(PLANE_THETA[0] - 2.5), np.radians(PLANE_THETA[-1] + 2.5)
+        box = (tl >= lo) & (tl <= hi) & (tv >= lo) & (tv <= hi) & (np.abs(ph) <= np.radians(PLANE_PHI[-1] + 7.5))
+        tl, tv, ph, value, weight = tl[~box], tv[~box], ph[~box], value[~box], weight[~box]
+        extra = [np.asarray(a, dtype=float) for a in planes]
+        finite = np.isfinite(extra[3])
+        extra = [a[finite] for a in extra]
+        tl, tv, ph, value = (np.concatenate([a, b]) for a, b in zip((tl, tv, ph, value), extra, strict=True))
+        weight = np.concatenate([weight, np.full(extra[0].size, float(np.median(count[count > 0])))])
+    return eevee.fit_table(closure, tl, tv, ph, value, prior, weight=weight)
 
 
 def write_module(path, version, tables, merge=False):
@@ -366,15 +489,19 @@ def main(argv=None):
         raw = np.load(args.from_raw)
         version = str(raw["version"])
         samples = [tuple(raw[f"{eevee.table_key(c)}/{j}"] for j in range(4)) for c in todo]
+        planes = [tuple(raw[f"{eevee.table_key(c)}/plane/{j}"] for j in range(4)) for c in todo]
     else:
         import bpy
 
         version = "{}.{}".format(*bpy.app.version[:2])
         samples = measure(todo, args.per_render)
+        planes = measure_planes(todo)
         if args.raw:
             flat = {f"{eevee.table_key(c)}/{j}": s[j] for c, s in zip(todo, samples, strict=True) for j in range(4)}
+            for c, s in zip(todo, planes, strict=True):
+                flat |= {f"{eevee.table_key(c)}/plane/{j}": s[j] for j in range(4)}
             np.savez_compressed(args.raw, version=version, **flat)
-    tables = {eevee.table_key(c): fitted_table(c, s) for c, s in zip(todo, samples, strict=True)}
+    tables = {eevee.table_key(c): fitted_table(c, s, p) for c, s, p in zip(todo, samples, planes, strict=True)}
     write_module(args.out, version, tables, merge=bool(args.only))
     print(f"wrote {len(tables)} tables for Blender {version} to {args.out}")
 

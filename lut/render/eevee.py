@@ -207,16 +207,20 @@ def _trilinear(table, theta_l, theta_v, phi):
     return np.sum(np.asarray(table).ravel()[cells] * weights, axis=-1)
 
 
-def fit_table(closure: Closure, theta_l, theta_v, phi, radiance, prior, *, regularisation=0.05, floor=0.01):
+def fit_table(
+    closure: Closure, theta_l, theta_v, phi, radiance, prior, *, weight=None, regularisation=0.05, floor=0.01
+):
     """The ratio table of ``closure`` that, interpolated as ``evaluate``
     interpolates it, best reproduces measured ``radiance`` (per unit
     irradiance) at scattered geometries (θl, θv, φ): the weighted least
     squares
 
-        min_T Σ_i (L_i − ref_i · Σ_c w_ic T_c)² / (ref_i + ε)
+        min_T Σ_i u_i (L_i − ref_i · Σ_c w_ic T_c)² / (ref_i + ε)
               + Σ_c λ_c (T_c − prior_c)²,
 
-    w_ic the trilinear weights of ``_corners``, ε = 10⁻³ max ref (so the
+    u_i the sample's ``weight`` (1 by default: one pixel; a plane's
+    geometry, whose pixels all see the same directions, counts as the
+    pixels it stands for), w_ic the trilinear weights of ``_corners``, ε = 10⁻³ max ref (so the
     residual counts relative to the lobe, the tails not ignored), λ_c =
     ``regularisation`` × the cell's own diagonal + ``floor`` × the mean
     diagonal (cells the data barely reach stay near ``prior``, e.g. the
@@ -228,6 +232,8 @@ def fit_table(closure: Closure, theta_l, theta_v, phi, radiance, prior, *, regul
     theta_l, theta_v, phi, radiance = (np.ravel(np.asarray(a, dtype=float)) for a in (theta_l, theta_v, phi, radiance))
     ref = reference(closure, theta_l, theta_v, phi)
     scale = 1.0 / np.sqrt(ref + 1e-3 * ref.max())
+    if weight is not None:
+        scale = scale * np.sqrt(np.broadcast_to(np.asarray(weight, dtype=float), scale.shape))
     cells, weights = _corners(theta_l, theta_v, phi)
     rows = (ref * scale)[:, None] * weights
     size = int(np.prod(TABLE_SHAPE))
