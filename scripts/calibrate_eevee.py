@@ -139,6 +139,37 @@ def sum_shader(tree, terms):
     return total
 
 
+def calibration_scene(size):
+    """A new EEVEE scene of ``size`` (x, y) pixels at one sample as the
+    calibration renders: no shadows, no ray tracing, no clamping, the film
+    filter off, the Standard view transform, a black world."""
+    from addon import scenes
+
+    scene = scenes.new_scene(scenes.EEVEE, 1, size)
+    scene.eevee.use_shadows = False
+    scene.eevee.use_raytracing = False
+    scene.eevee.clamp_surface_direct = 0.0
+    scene.render.filter_size = 0.0
+    scene.view_settings.view_transform = "Standard"
+    scenes.add_world(scene, 0.0, name="black")
+    return scene
+
+
+def calibration_material(name, terms):
+    """A new material whose surface is the sum of ``terms`` [(closure, weight)]."""
+    import bpy
+
+    mat = bpy.data.materials.new(name)
+    if mat.node_tree is None:  # Blender 4.x
+        mat.use_nodes = True
+    tree = mat.node_tree
+    for node in list(tree.nodes):
+        tree.nodes.remove(node)
+    out = tree.nodes.new("ShaderNodeOutputMaterial")
+    tree.links.new(sum_shader(tree, terms), out.inputs["Surface"])
+    return mat
+
+
 class SphereScene:
     """Spheres in a grid (``objects``), one material each (a list of
     [(closure, weight)] sums; None: no material, for the caller to assign),
@@ -146,21 +177,14 @@ class SphereScene:
     ``addon.scenes``' parts)."""
 
     def __init__(self, materials, cell=CELL, columns=None):
-        import bpy
 
         from addon import scenes
 
         columns = columns or math.ceil(math.sqrt(len(materials)))
         rows = math.ceil(len(materials) / columns)
-        scene = scenes.new_scene(scenes.EEVEE, 1, (columns * cell, rows * cell))
-        scene.eevee.use_shadows = False
-        scene.eevee.use_raytracing = False
-        scene.eevee.clamp_surface_direct = 0.0
-        scene.render.filter_size = 0.0
+        scene = calibration_scene((columns * cell, rows * cell))
         scene.render.threads_mode = "FIXED"
         scene.render.threads = 1
-        scene.view_settings.view_transform = "Standard"
-        scenes.add_world(scene, 0.0, name="black")
         settings = scene.render.image_settings
         if hasattr(settings, "media_type"):  # Blender 5.0 on
             settings.media_type = "MULTI_LAYER_IMAGE"
@@ -177,13 +201,7 @@ class SphereScene:
             self.cells.append((row, col))
             if terms is None:
                 continue
-            mat = bpy.data.materials.new(f"m{i}")
-            tree = mat.node_tree
-            for node in list(tree.nodes):
-                tree.nodes.remove(node)
-            out = tree.nodes.new("ShaderNodeOutputMaterial")
-            tree.links.new(sum_shader(tree, terms), out.inputs["Surface"])
-            sphere.data.materials.append(mat)
+            sphere.data.materials.append(calibration_material(f"m{i}", terms))
         scenes.add_camera(scene, location=(0.0, 0.0, 10.0), ortho_scale=2.2 * max(columns, rows))
         self.sun = scenes.add_sun(scene, energy=1.0, angle=0.0)
         self.sun.data.use_shadow = False
@@ -262,7 +280,8 @@ class PlaneScene:
     as any other."""
 
     #: Pixels across the render, and the squares' side and spacing (scene
-    #: units): at θv = 75° a square spans 0.26 of its side, about 7 pixels.
+    #: units): at θv = 75° a square spans 0.26 of its side, about 11 pixels
+    #: for the 49 closures (a 7 x 7 grid in a frame 1.5 times its width).
     SIZE, SIDE, PITCH = 640, 1.0, 1.4
 
     def __init__(self, todo):
@@ -271,15 +290,9 @@ class PlaneScene:
         from addon import scenes
 
         columns = math.ceil(math.sqrt(len(todo)))
-        scene = scenes.new_scene(scenes.EEVEE, 1, (self.SIZE, self.SIZE))
-        scene.eevee.use_shadows = False
-        scene.eevee.use_raytracing = False
-        scene.eevee.clamp_surface_direct = 0.0
-        scene.render.filter_size = 0.0
-        scene.view_settings.view_transform = "Standard"
+        scene = calibration_scene((self.SIZE, self.SIZE))
         scene.render.image_settings.file_format = "OPEN_EXR"
         scene.render.image_settings.color_depth = "32"
-        scenes.add_world(scene, 0.0, name="black")
         half = self.SIDE / 2
         self.centres = []
         for i, closure in enumerate(todo):
@@ -290,15 +303,7 @@ class PlaneScene:
             mesh.from_pydata(corners, [], [(0, 1, 2, 3)])
             square = bpy.data.objects.new(f"square{i}", mesh)
             scene.collection.objects.link(square)
-            mat = bpy.data.materials.new(f"p{i}")
-            if mat.node_tree is None:  # Blender 4.x
-                mat.use_nodes = True
-            tree = mat.node_tree
-            for node in list(tree.nodes):
-                tree.nodes.remove(node)
-            out = tree.nodes.new("ShaderNodeOutputMaterial")
-            tree.links.new(closure_shader(tree, closure), out.inputs["Surface"])
-            mesh.materials.append(mat)
+            mesh.materials.append(calibration_material(f"p{i}", [(closure, 1.0)]))
             self.centres.append((x, y))
         # The frame turns with the view about its axis: it spans the grid's diagonal.
         self.camera = scenes.add_camera(scene, ortho_scale=self.PITCH * columns * 1.5)
@@ -489,7 +494,9 @@ def main(argv=None):
         raw = np.load(args.from_raw)
         version = str(raw["version"])
         samples = [tuple(raw[f"{eevee.table_key(c)}/{j}"] for j in range(4)) for c in todo]
-        planes = [tuple(raw[f"{eevee.table_key(c)}/plane/{j}"] for j in range(4)) for c in todo]
+        # Raw samples kept before the squares were measured have none: spheres alone.
+        keys = [f"{eevee.table_key(c)}/plane" for c in todo]
+        planes = [tuple(raw[f"{k}/{j}"] for j in range(4)) if f"{k}/0" in raw.files else None for k in keys]
     else:
         import bpy
 
