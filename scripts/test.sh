@@ -21,7 +21,14 @@ run() {
     fi
 }
 
-run .venv/bin/python -m pytest "$@"
+# Cycles renders (the ``cycles`` marker) run once: under Blender 5.2 LTS when
+# .venv-bpy52 exists, else under 5.0.  EEVEE renders run under both, each
+# against its own version's tables.
+if [ -x .venv-bpy52/bin/python ]; then
+    run env PAINT_LUT_CYCLES_ELSEWHERE="Blender 5.2 LTS (.venv-bpy52)" .venv/bin/python -m pytest "$@"
+else
+    run .venv/bin/python -m pytest "$@"
+fi
 
 if [ -x .venv-bpy52/bin/python ]; then
     mapfile -t blender_tests < <(grep -l 'importorskip("bpy")' tests/test_*.py)

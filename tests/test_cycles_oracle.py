@@ -15,7 +15,7 @@ from addon.scenes import Oracle, oracle_errors, paint_material, paints  # noqa: 
 from lut import bench, models  # noqa: E402
 from lut.render import closures, fitting, measure  # noqa: E402
 
-pytestmark = pytest.mark.render
+pytestmark = [pytest.mark.render, pytest.mark.cycles]
 
 
 @pytest.fixture(scope="module")

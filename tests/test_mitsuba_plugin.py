@@ -98,7 +98,16 @@ def is_delta(bs) -> bool:
     return bool(int(first(bs.sampled_type)) & int(mi.BSDFFlags.DeltaReflection))
 
 
-@pytest.mark.parametrize("index", range(len(PAINTS)), ids=[label for label, _ in PAINTS])
+#: The eval test's paints: both smooth ones and the rough ones the rendered
+#: test bakes anyway (Gaussian with g < 0 and a large slope with g > 0, an
+#: exponential with g > 0).  A rough paint's Mueller LUT takes about two
+#: minutes to bake on two cores, so the other three rough paints of
+#: ``PAINTS`` are not baked in every CI run (the three kept cover both
+#: distributions and both signs of g).
+EVAL = [0, 1, 2, 4, 5]
+
+
+@pytest.mark.parametrize("index", EVAL, ids=[PAINTS[i][0] for i in EVAL])
 def test_eval_matches_the_models_mueller_matrix(index, cache):
     """200 random geometries: up to 75° (the fidelity measure's domain), the
     normal included, and 48 with light or view between 75° and 89° (towards
@@ -260,20 +269,21 @@ def test_a_variant_that_is_not_polarized_is_refused_with_the_choices():
 
 def test_the_polarized_command_writes_stokes_images_and_a_figure(tmp_path, capsys):
     """``python -m lut polarized``: a preset's sphere with germer_paint and
-    pplastic; the EXRs hold S0..S3 (RGB each), whose luminance is light's
-    (S0 >= |(S1, S2, S3)|), and the figure is written."""
+    pplastic (the smooth preset, whose Mueller LUT bakes in seconds); the
+    EXRs hold S0..S3 (RGB each), whose luminance is light's (S0 >= |(S1, S2,
+    S3)|), and the figure is written."""
     import OpenImageIO as oiio
 
     from lut.__main__ import main
 
-    assert main(["polarized", "--preset", "glossy_red", "--out", str(tmp_path), "--size", "16", "--spp", "2"]) == 0
+    assert main(["polarized", "--preset", "glossy_white", "--out", str(tmp_path), "--size", "16", "--spp", "2"]) == 0
     out = capsys.readouterr().out
     assert "germer_paint: rendered" in out and "pplastic: rendered" in out
-    assert (tmp_path / "glossy_red-polarized.png").stat().st_size > 10_000
+    assert (tmp_path / "glossy_white-polarized.png").stat().st_size > 10_000
     for what in ("dolp", "aolp"):
-        assert (tmp_path / f"glossy_red-{what}-germer_paint.png").stat().st_size > 100
+        assert (tmp_path / f"glossy_white-{what}-germer_paint.png").stat().st_size > 100
     for kind in ("germer_paint", "pplastic"):
-        image = oiio.ImageInput.open(str(tmp_path / f"glossy_red-stokes-{kind}.exr"))
+        image = oiio.ImageInput.open(str(tmp_path / f"glossy_white-stokes-{kind}.exr"))
         assert image.spec().channelnames[:4] == ("S0.R", "S0.G", "S0.B", "S1.R")
         pixels = image.read_image("float").reshape(16, 16, 4, 3)
         image.close()

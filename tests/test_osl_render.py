@@ -17,7 +17,7 @@ from addon.scenes import Oracle, paint_material  # noqa: E402
 from lut import bench  # noqa: E402
 from lut.render import measure  # noqa: E402
 
-pytestmark = pytest.mark.render
+pytestmark = [pytest.mark.render, pytest.mark.cycles]
 
 #: Paints of the randomised set the fit was not tuned on (test_osl.py's):
 #: rough Gaussian and exponential ones and a dark rough one.

@@ -17,7 +17,7 @@ from addon.scenes import EEVEE, Oracle, oracle_errors, principled_params_materia
 from addon.scenes import principled as artists_principled  # noqa: E402
 from lut.render import measure, principled  # noqa: E402
 
-pytestmark = pytest.mark.render
+pytestmark = [pytest.mark.render, pytest.mark.cycles]
 
 #: Light/view geometries (θl, θv, φ), grazing ones included.
 GEOMETRIES = [(0.0, 0.1, 1.1), (0.5, 0.7, 1.2), (1.0, 0.35, 3.1), (0.26, 1.3, 0.4), (1.3, 1.3, 0.4), (0.8, 0.6, 0.1)]

@@ -39,6 +39,7 @@ def test_eevee_renders_its_own_fit(registered, tmp_path):
     assert relative_rms(oracle, paint, grid) > 0.08
 
 
+@pytest.mark.cycles
 def test_principled_facet_lobes_for_blender_4(registered, tmp_path):
     """Blender 4.2-4.5 get Principled (GGX, black base) facet lobes: exact
     Fresnel, GGX instead of Beckmann; the satin paint stays within 5%."""
