@@ -121,6 +121,18 @@ def add_camera(scene, location=(0.0, 0.0, 0.0), rotation=(0.0, 0.0, 0.0), ortho_
     return camera
 
 
+def aim(sun, camera, theta_l, theta_v, phi, distance=5.0):
+    """Set one geometry of ``lut.models``' convention on a scene lying in the
+    plane z = 0: the Sun at θl from the normal in the plane y = 0 (the
+    model's source at azimuth π; the Sun points along -Z rotated about Y),
+    and the camera ``distance`` away along the view (θv, φ: φ = 0 is the
+    mirror side), looking at the origin."""
+    sun.rotation_euler = (0.0, -theta_l, 0.0)
+    view = Vector((math.sin(theta_v) * math.cos(phi), math.sin(theta_v) * math.sin(phi), math.cos(theta_v)))
+    camera.location = distance * view
+    camera.rotation_euler = view.to_track_quat("Z", "Y").to_euler()
+
+
 def add_uv_sphere(segments, ring_count, **options):
     """A smooth-shaded UV sphere (``bpy.ops.mesh.primitive_uv_sphere_add``'s options)."""
     bpy.ops.mesh.primitive_uv_sphere_add(segments=segments, ring_count=ring_count, **options)
@@ -185,10 +197,7 @@ class Oracle:
     def image(self, theta_l, theta_v, phi):
         """The whole rendered image (RESOLUTION², RGB) for one geometry: every
         pixel of the plane sees the same directions."""
-        self.sun.rotation_euler = (0.0, -theta_l, 0.0)
-        view = Vector((math.sin(theta_v) * math.cos(phi), math.sin(theta_v) * math.sin(phi), math.cos(theta_v)))
-        self.camera.location = 5.0 * view
-        self.camera.rotation_euler = view.to_track_quat("Z", "Y").to_euler()
+        aim(self.sun, self.camera, theta_l, theta_v, phi)
         self.scene.render.filepath = self._path
         bpy.ops.render.render(write_still=True)
         try:

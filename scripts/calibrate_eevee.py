@@ -320,10 +320,9 @@ class PlaneScene:
         from bpy_extras.object_utils import world_to_camera_view
         from mathutils import Vector
 
-        self.sun.rotation_euler = (0.0, -theta_l, 0.0)
-        view = Vector((math.sin(theta_v) * math.cos(phi), math.sin(theta_v) * math.sin(phi), math.cos(theta_v)))
-        self.camera.location = 20.0 * view
-        self.camera.rotation_euler = view.to_track_quat("Z", "Y").to_euler()
+        from addon import scenes
+
+        scenes.aim(self.sun, self.camera, theta_l, theta_v, phi, distance=20.0)
         bpy.context.view_layer.update()
         self.scene.render.filepath = self._path
         bpy.ops.render.render(write_still=True)
