@@ -10,6 +10,7 @@ import pytest
 
 from lut import bench
 from lut.lutfiles import baking
+from lut.paint.core import COMPONENTS
 from lut.render import bake as render_bake
 from lut.render import eevee, fitting, measure
 from lut.render.closures import Closure
@@ -69,9 +70,10 @@ def test_converged_fits_of_sharp_exponential_paints_come_near_the_model(random_s
     that keeps its exact fit would gain in bias (a converged fit of it is
     within 14% too) but not at the viewport's samples: its sharp lobe peaks at
     the grazing mirror, where EEVEE seldom picks it, so its pixels there
-    scatter so widely that, at its colour, bias and spread together are
-    more than ``CONVERGED_GAIN`` times the exact fit's error (the fit's own
-    rule weighs the same two over the type's component colours)."""
+    scatter more widely than the fit's bias (at its own colour 19% at 16
+    samples against 11.5%), and over the type's component colours, bias and
+    spread together, it comes less than ``CONVERGED_GAIN`` nearer the goals
+    than the exact fit (0.93 of its shortfall; the kept fits 0.52-0.74)."""
     kept = 0
     for paint, table, exact, converged in random_set:
         if paint.distribution != "exponential" or not 0.05 < paint.slope < 0.25:
@@ -88,8 +90,16 @@ def test_converged_fits_of_sharp_exponential_paints_come_near_the_model(random_s
         )  # fmt: skip
         assert not forced.sums_exactly
         assert forced.error(amps) < 0.14, paint
-        noisy = np.hypot(forced.error(amps), eevee.spread(forced, amps, eevee.VIEWPORT_SAMPLES))
-        assert noisy > fitting.CONVERGED_GAIN * exact.error(amps), paint
+        assert eevee.spread(forced, amps, eevee.VIEWPORT_SAMPLES) > forced.error(amps), paint
+        # The fit's rule, from the public noise model: each component's
+        # spread at its own colour, or at every component's where noisier.
+        samples = eevee.VIEWPORT_SAMPLES
+        mixed = eevee.spread(forced, np.ones((3, len(COMPONENTS))), samples)
+        colours = eevee.component_colours(len(COMPONENTS))
+        spreads = {c: max(eevee.spread(forced, a, samples), mixed) for c, a in zip(COMPONENTS, colours, strict=True)}
+        goals = measure.goals("EEVEE", False)
+        noisy = fitting.shortfall(*_grams(forced), goals, spreads)
+        assert noisy >= fitting.CONVERGED_GAIN * fitting.shortfall(*_grams(exact), goals), paint
     assert kept >= 4
 
 

@@ -68,7 +68,7 @@ from .nnls import nnls_gram_batch, solve_spd
 #: Fit format version: bumped when the weights file layout or the fit changes.
 #: It is part of the weights file's name (``fit_path``), so a new release
 #: never overwrites a file that an older release's node groups still read.
-FIT_VERSION = 10
+FIT_VERSION = 11
 
 #: Goals of the fidelity measure (whole domain) per engine and kind of
 #: paint (``lut.render.measure.GOALS``; the grazing band's are twice these).
