@@ -164,9 +164,9 @@ def test_a_converged_eevee_render_comes_near_its_prediction_on_the_plane_oracle(
     geometry that dominates the measure is the mirror at θl = θv = 75°), the
     mean of 32 × 32 pixels at one sample (closures picked per pixel at
     random, so the mean is a many-sample render's).  Measured on Blender
-    5.0 (16 × 16 pixels): the exact fit renders at 31.5% (predicts 29.9%),
-    the converged one at 14.2% (predicts 9.4%; the mean of that geometry's
-    pixels is noisy)."""
+    5.0 (16 × 16 pixels): the exact fit renders at 30.2% (predicts 30.7%),
+    the converged one at 10.7% (predicts 10.0%; the mean of the grazing
+    mirror's pixels is noisy)."""
     import bpy
 
     from addon import nodes, scenes
@@ -211,8 +211,8 @@ def test_a_converged_fits_noise_at_the_viewports_samples_is_as_the_noise_model_p
     not above it by more than 15% (the fit counts that spread against its
     goals, so a model that under-predicted would let noise through), and
     falling with samples at least as fast as the model's N^-0.7.  Measured on
-    Blender 5.0 at this paint's noisiest geometry: 98% (predicted 127%) at
-    one sample, 11.8% (18.2%) at 16."""
+    Blender 5.0 at this paint's noisiest geometry (16 × 16 pixels): 72%
+    (predicted 66%) at one sample, 8.4% (9.5%) at 16."""
     import bpy
 
     from addon import nodes, scenes
