@@ -4,10 +4,11 @@ Each closure alone (white, weight 1, built as ``scripts/calibrate_eevee``
 builds it) on the plane oracle (``addon.scenes.Oracle``: a delta Sun, an
 orthographic camera, a black world; EEVEE at one sample), rendered at
 ``GEOMETRIES`` and divided by what the tables give there
-(``lut.render.eevee.evaluate``, the tables of the running Blender's line).  A ratio of 1 is a
-table that is right; the tables are fitted to spheres' pixels, which thin
-out toward the silhouette, so the grazing mirror (θl, θv 60–75°, φ 0°) is
-where they are least constrained.
+(``lut.render.eevee.evaluate``, the tables of the running Blender's
+line).  A ratio of 1 is a table that is right.  The grazing mirror (θl, θv
+60–75°, φ 0°) is where spheres' pixels thin out toward the silhouette, so
+``scripts/calibrate_eevee.py`` fits that band to flat squares instead; this
+checks it on the plane oracle, independently of both.
 
     .venv/bin/python scripts/eevee_table_check.py [--kind glossy] [--roughness 0.2 0.3 0.45 0.6]"""
 
