@@ -17,7 +17,11 @@ The fit, per render target (``fit_lut``):
    not extrapolated); each row is radiance
    L = f·cos θl weighted by its share of the fidelity measure
    (``lut.render.measure``: uniform in θl and φ, dθl dφ = dω/sin θl with
-   dω_l = 4 (h·v) dω_h) and nothing further.  Targets come from the LUT.
+   dω_l = 4 (h·v) dω_h) and nothing further; for rough Cycles types also
+   the exact mirror direction of each view as one cell of the measure's
+   lattice (``mirror_rows``: the measure's grid holds it, and a cusp-like
+   peak narrower than its steps weighs there as its top).  Targets come
+   from the LUT.
 2. Selection.  Forward selection: from the target's candidate closures,
    repeatedly add the one that most reduces the sum over components of the
    squared relative error on the measure, views weighted by their share of
@@ -68,7 +72,7 @@ from .nnls import nnls_gram_batch, solve_spd
 #: Fit format version: bumped when the weights file layout or the fit changes.
 #: It is part of the weights file's name (``fit_path``), so a new release
 #: never overwrites a file that an older release's node groups still read.
-FIT_VERSION = 11
+FIT_VERSION = 12
 
 #: Goals of the fidelity measure (whole domain) per engine and kind of
 #: paint (``lut.render.measure.GOALS``; the grazing band's are twice these).
@@ -141,24 +145,44 @@ _CANDIDATES_CHECKED = 4
 #: The rows a fit is made on, tried in turn until one meets its goals (the fit kept is the one
 #: nearest its goals on the measure, ``shortfall``): "hemisphere", light
 #: directions of a half-vector grid weighted by their share of the measure
-#: (a continuous integral, dense about the mirror); "lattice", those and the
-#: measure's own lattice of lights about each view, its exact mirror
-#: included; "grazing", the hemisphere's rows with the grazing band
-#: emphasised.  The measure counts each of its geometries once, so a lobe
-#: much narrower than its 5° steps weighs there as much as its peak value
-#: at the mirror: the integral alone under-weights that peak, the lattice
-#: alone the shape between its points.  And a fit of the whole measure may
-#: give up the grazing band, which has goals of its own.  Measured on
-#: ``lut.bench.random_paints(24)``: near-smooth exponential slopes 8.2% ->
-#: 3.2% (the lattice), a smooth back-scattering paint's grazing band 9.4%
-#: -> 5.6% (the emphasis).
-ROW_SETS = ("hemisphere", "lattice", "grazing")
-#: The row sets a fit tries by default.  Not the lattice: it fits the
-#: measure's points at the cost of the shape between them, which a render of
-#: a curved object shows (a near-smooth exponential slope: 2.9% on the
-#: measure's grid, 6.7% on every pixel of a sphere, binned).
-DEFAULT_ROW_SETS = ("hemisphere", "grazing")
-#: The "grazing" row set: the hemisphere's rows with lights in the grazing
+#: (a continuous integral, dense about the mirror); "mirror", those and the
+#: exact mirror direction of each view weighted as one cell of the
+#: measure's lattice (``mirror_rows``); "lattice", the hemisphere's rows and
+#: the measure's whole lattice of lights about each view, its exact mirror
+#: included; "grazing" and "grazing-mirror", the hemisphere's rows (and the
+#: mirror's) with the grazing band emphasised.  The measure counts each of
+#: its geometries once, and its grid holds the exact mirror of every one of
+#: its views (θl and θv share their steps), so a lobe much narrower than its
+#: 5° steps weighs there as much as its peak value at the mirror: the
+#: integral alone under-weights that peak, the lattice alone the shape
+#: between its points, and the integral plus the mirror point does neither.
+#: A fit of the whole measure may give up the grazing band, which has goals
+#: of its own.  Measured on ``lut.bench.random_paints(24)``: near-smooth
+#: exponential slopes 8.2% -> 3.2% (the lattice), a smooth back-scattering
+#: paint's grazing band 9.4% -> 5.6% (the emphasis); with the mirror point,
+#: exponential slopes 0.08-0.2 4.0-6.3% -> 1.0-2.2%, while a grid of lights
+#: 2.5° off the measure's (which never meets the mirror) stays within
+#: 0.8% of the fit without it (docs/render.md).
+ROW_SETS = ("hemisphere", "mirror", "lattice", "grazing", "grazing-mirror")
+#: The row sets a fit tries by default, per target.  Not the lattice: it fits
+#: the measure's points at the cost of the shape between them, which a render
+#: of a curved object shows (a near-smooth exponential slope: 2.9% on the
+#: measure's grid, 6.7% on every pixel of a sphere, binned).  The mirror
+#: point is tried for Cycles (and so the OSL variant, made on Cycles' fit);
+#: EEVEE draws every lobe as its own GGX, whose rounded top cannot follow an
+#: exponential slope's peak, and its fits keep the rows they were measured
+#: on (docs/eevee.md).  Only exponential slopes try the mirror sets: their
+#: density, exp(-|s|/a), has a cusp at the mirror, sharper than any Beckmann
+#: lobe, where a Gaussian slope's is a Beckmann lobe's rounded top, which
+#: the integral already draws (the Gaussian types of the randomised and
+#: dark sets fit within 0.3% of the same with the mirror sets, each set of
+#: rows a selection of about 0.4 s); a smooth type's mirror the measure
+#: leaves out.
+DEFAULT_ROW_SETS = {
+    "CYCLES": ("hemisphere", "mirror", "grazing", "grazing-mirror"),
+    "EEVEE": ("hemisphere", "grazing"),
+}
+#: The "grazing" row sets: the hemisphere's rows with lights in the grazing
 #: band weighted this much more (in amplitude), for types whose fall-off
 #: toward the horizon the plain measure gives up to gain elsewhere.
 GRAZING_EMPHASIS = 2.0
@@ -375,6 +399,17 @@ def reported_errors(grams: dict, amplitudes) -> tuple[float, float]:
     return whole, gram_error(grams["grazing_residual"], grams["grazing_reference"], amplitudes)
 
 
+def between_errors(fitted: Fit, paint, amplitudes) -> tuple[float, float]:
+    """(whole, grazing band) ε of a fit's radiance against the paper's model
+    at the geometries of ``measure.BETWEEN_GRID``, between the measure's own
+    (none at the mirror direction): a check that the fit holds between the
+    points it is measured at.  ``paint``: a ``lut.Paint`` of the fit's type,
+    ``amplitudes`` its ``Paint.amplitudes``."""
+    tl, tv, ph = measure.points(fitted.mirror, measure.BETWEEN_GRID)
+    model = paint.brdf(tl, tv, ph) * np.cos(tl)[:, None]
+    return measure.errors(fitted.radiance(amplitudes, tl, tv, ph), model, tl)
+
+
 def reported_error(grams: dict, amplitudes) -> float:
     """The fidelity measure a fit reports for a colour (``Fit.error``)."""
     return reported_errors(grams, amplitudes)[0]
@@ -479,6 +514,19 @@ def lattice_rows(theta_v, max_light=MAX_LIGHT):
     weight = weight * np.where(theta_l > MEASURE_LIGHT + 1e-9, BEYOND_WEIGHT, 1.0)
     weight[:, -1] = np.where(np.asarray(theta_v) <= max_light, weight[:, -1], 0.0)
     return theta_l, phi, weight
+
+
+def mirror_rows(theta_v):
+    """The exact mirror direction of each view (θl = θv, φ = 0), which the
+    measure's grid holds for each of its views: (θl, φ, row weight), shape
+    (M, 1), weight the square root of one lattice cell dθl dφ (as
+    ``lattice_rows``), nil for views past the measure's (``measure.GRID``).
+    Beside the hemisphere's rows, which stand for the measure's integral,
+    it gives the peak the weight the measure's lattice gives it."""
+    theta_v = np.asarray(theta_v, dtype=float).reshape(-1, 1)
+    cell = (measure.GRID[0][1] - measure.GRID[0][0]) * (measure.GRID[2][1] - measure.GRID[2][0])
+    weight = np.where(theta_v <= measure.GRID[1][-1] + 1e-9, np.sqrt(cell), 0.0)
+    return theta_v.copy(), np.zeros_like(theta_v), weight
 
 
 # ---------------------------------------------------------------------- selection
@@ -667,28 +715,29 @@ def read_weights(weights, cos_view, cos_v, columns=False):
 
 
 @functools.lru_cache(maxsize=4)
-def _model_radiance(type_json: str, single_nodes, diffuse_nodes, smooth: bool):
-    """The paper's model at the measure's geometries (``measure.points``):
-    (θl, θv, φ) and each colour-free component's radiance f·cos θl
-    (N, T, C), computed once per paint type."""
+def _model_radiance(type_json: str, single_nodes, diffuse_nodes, smooth: bool, between: bool = False):
+    """The paper's model at the measure's geometries (``measure.points``;
+    with ``between``, those of ``measure.BETWEEN_GRID``): (θl, θv, φ) and
+    each colour-free component's radiance f·cos θl (N, T, C), computed once
+    per paint type."""
     from ..paint.core import Paint
 
     paint = Paint.from_dict(json.loads(type_json))
     opts = {}
     if single_nodes is not None:
         opts = {"single_nodes": single_nodes, "diffuse_nodes": diffuse_nodes}
-    tl, tv, ph = measure.points(smooth)
+    tl, tv, ph = measure.points(smooth, measure.BETWEEN_GRID if between else measure.GRID)
     return (tl, tv, ph), paint.components(tl, tv, ph, **opts) * np.cos(tl)[:, None, None]
 
 
-def model_radiance(lut):
+def model_radiance(lut, between=False):
     """``_model_radiance`` of a loaded LUT's paint type, with the LUT's own
     quadrature sizes."""
     meta = lut.meta
     single = tuple(meta["single_nodes"]) if "single_nodes" in meta else None
     diffuse = tuple(meta["diffuse_nodes"]) if "diffuse_nodes" in meta else None
     smooth = float(meta["type"]["slope"]) == 0.0
-    return _model_radiance(json.dumps(meta["type"], sort_keys=True), single, diffuse, smooth)
+    return _model_radiance(json.dumps(meta["type"], sort_keys=True), single, diffuse, smooth, bool(between))
 
 
 def measure_grams(model, basis, cos_view, weights, evaluate, *, columns=False, values=None):
@@ -738,7 +787,7 @@ def fit_lut(
     views=VIEWS,
     grid=LIGHT_GRID,
     calibration=None,
-    row_sets=DEFAULT_ROW_SETS,
+    row_sets=None,
     eevee_mode=DEFAULT_EEVEE_MODE,
     converged_budget=CONVERGED_BUDGET,
     converged_extra=CONVERGED_EXTRA,
@@ -766,6 +815,10 @@ def fit_lut(
     extra_budget = EXTRA_BUDGET[target] if extra_budget is None else int(extra_budget)
     if extra_budget < 0:
         raise ValueError(f"extra_budget must be a whole number >= 0, got {extra_budget!r}")
+    if row_sets is None:
+        row_sets = DEFAULT_ROW_SETS[target]
+        if float(lut.meta["type"]["slope"]) == 0.0 or lut.meta["type"]["distribution"] != "exponential":
+            row_sets = tuple(r for r in row_sets if not r.endswith("mirror"))
     row_sets = tuple(validate_row_set(r) for r in row_sets)
     if not row_sets:
         raise ValueError(f"row_sets must name at least one of {', '.join(ROW_SETS)}")
@@ -780,11 +833,19 @@ def fit_lut(
     model = model_radiance(lut)
     best = None
     exact = target == "EEVEE"
+    # Where a set of rows holds the mirror point, every fit is also scored
+    # between the measure's points (``measure.BETWEEN_GRID``): a fit must not
+    # buy the measure's mirror points with the shape between them.
+    between = model_radiance(lut, between=True) if any(r.endswith("mirror") for r in row_sets) else None
+    goals = measure.goals(target, float(type_dict["slope"]) == 0.0)
     for row_set in row_sets:
         theta_l, phi, row_w = _rows(row_set, theta_v, grid)
         fitted = _fit_rows(
             lut, target, evaluate, basis, theta_v, theta_l, phi, row_w, model, budget, extra_budget, exact
         )  # fmt: skip
+        if between is not None:
+            off = measure_grams(between, fitted[0], cos_view, fitted[1], evaluate)
+            fitted = (*fitted[:-1], max(fitted[-1], shortfall(*off, goals)))
         if best is None or fitted[-1] < best[-1]:
             best, best_rows = fitted, row_set
         if best[-1] <= 1.0:  # every colour of the type meets both goals: the next sets need not be tried
@@ -1130,14 +1191,16 @@ def shortfall(whole, band, goals, spreads=None) -> float:
 
 def _rows(row_set, theta_v, grid):
     """The fit's rows of a row set (``ROW_SETS``): (θl, φ, weight), (M, R)."""
-    rows = light_rows(theta_v, grid)
-    if row_set == "hemisphere":
-        return rows
-    if row_set == "grazing":
-        theta_l, phi, weight = rows
-        return theta_l, phi, np.where(theta_l >= measure.GRAZING, GRAZING_EMPHASIS, 1.0) * weight
-    lattice = lattice_rows(theta_v)
-    return tuple(np.concatenate([x, y], axis=1) for x, y in zip(rows, lattice, strict=True))
+    theta_l, phi, weight = light_rows(theta_v, grid)
+    if row_set.startswith("grazing"):
+        weight = np.where(theta_l >= measure.GRAZING, GRAZING_EMPHASIS, 1.0) * weight
+    extra = {"lattice": lattice_rows, "mirror": mirror_rows, "grazing-mirror": mirror_rows}.get(row_set)
+    if extra is None:
+        return theta_l, phi, weight
+    more = extra(theta_v)
+    if row_set == "grazing-mirror":
+        more = (*more[:2], np.where(more[0] >= measure.GRAZING, GRAZING_EMPHASIS, 1.0) * more[2])
+    return tuple(np.concatenate([x, y], axis=1) for x, y in zip((theta_l, phi, weight), more, strict=True))
 
 
 def _fit_rows(

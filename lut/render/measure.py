@@ -29,6 +29,12 @@ GRID = (
     np.radians(np.arange(5.0, 75.1, 5.0)),
     np.radians(np.arange(0.0, 180.1, 10.0)),
 )
+#: The measure's grid with its lights shifted half a step (θl 2.5-72.5°):
+#: geometries between the measure's, none of them at the mirror direction
+#: (θl and θv no longer share their steps).  Not a measure of its own: a
+#: check that a fit holds between the measure's points
+#: (``lut.render.fitting.fit_lut``, ``scripts/fit_fidelity.py --between``).
+BETWEEN_GRID = (np.radians(np.arange(2.5, 75.0, 5.0)), GRID[1], GRID[2])
 #: Smooth paints: geometries this close to the mirror direction are left out.
 MIRROR_EXCLUSION = np.radians(5.0)
 #: The grazing band: lights at least this far from the normal.
