@@ -160,9 +160,9 @@ _CANDIDATES_CHECKED = 4
 #: of its own.  Measured on ``lut.bench.random_paints(24)``: near-smooth
 #: exponential slopes 8.2% -> 3.2% (the lattice), a smooth back-scattering
 #: paint's grazing band 9.4% -> 5.6% (the emphasis); with the mirror point,
-#: exponential slopes 0.08-0.2 4.0-6.3% -> 1.0-2.2%, while a grid of lights
-#: 2.5° off the measure's (which never meets the mirror) stays within
-#: 0.8% of the fit without it (docs/render.md).
+#: exponential slopes 0.08-0.12 4.0-6.3% -> 1.4-2.2%, and between the
+#: measure's points (``measure.BETWEEN_GRID``) 1.6%, 2.5% and 3.5% ->
+#: 1.7%, 3.5% and 3.2% (docs/fidelity.md).
 ROW_SETS = ("hemisphere", "mirror", "lattice", "grazing", "grazing-mirror")
 #: The row sets a fit tries by default, per target.  Not the lattice: it fits
 #: the measure's points at the cost of the shape between them, which a render
