@@ -33,7 +33,8 @@ GRID = (
 #: geometries between the measure's, none of them at the mirror direction
 #: (θl and θv no longer share their steps).  Not a measure of its own: a
 #: check that a fit holds between the measure's points
-#: (``lut.render.fitting.fit_lut``, ``scripts/fit_fidelity.py --between``).
+#: (``lut.render.fitting.fit_lut``; the "CYCLES between" figures of
+#: ``scripts/fit_fidelity.py``).
 BETWEEN_GRID = (np.radians(np.arange(2.5, 75.0, 5.0)), GRID[1], GRID[2])
 #: Smooth paints: geometries this close to the mirror direction are left out.
 MIRROR_EXCLUSION = np.radians(5.0)
