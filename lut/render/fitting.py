@@ -1201,16 +1201,14 @@ def shortfall(whole, band, goals, spreads=None) -> float:
 
 def _rows(row_set, theta_v, grid):
     """The fit's rows of a row set (``ROW_SETS``): (θl, φ, weight), (M, R)."""
-    theta_l, phi, weight = light_rows(theta_v, grid)
+    rows = light_rows(theta_v, grid)
+    extra = {"lattice": lattice_rows, "mirror": mirror_rows, "grazing-mirror": mirror_rows}.get(row_set)
+    if extra is not None:
+        rows = tuple(np.concatenate([x, y], axis=1) for x, y in zip(rows, extra(theta_v), strict=True))
+    theta_l, phi, weight = rows
     if row_set.startswith("grazing"):
         weight = np.where(theta_l >= measure.GRAZING, GRAZING_EMPHASIS, 1.0) * weight
-    extra = {"lattice": lattice_rows, "mirror": mirror_rows, "grazing-mirror": mirror_rows}.get(row_set)
-    if extra is None:
-        return theta_l, phi, weight
-    more = extra(theta_v)
-    if row_set == "grazing-mirror":
-        more = (*more[:2], np.where(more[0] >= measure.GRAZING, GRAZING_EMPHASIS, 1.0) * more[2])
-    return tuple(np.concatenate([x, y], axis=1) for x, y in zip((theta_l, phi, weight), more, strict=True))
+    return theta_l, phi, weight
 
 
 def _fit_rows(
