@@ -806,8 +806,7 @@ def fit_lut(
     None: Cycles' formulas, EEVEE's own rendering unmodelled).  ``row_sets``:
     the rows to fit on, tried in turn (``ROW_SETS``) until a fit meets its
     goals; the fit kept is the one nearest them (``shortfall``); None: the
-    target's ``DEFAULT_ROW_SETS``; sets with the mirror point are used
-    for exponential slopes alone.  Where a set with the mirror point is tried,
+    target's ``DEFAULT_ROW_SETS`` (none with the mirror point).  Where a set with the mirror point is tried,
     each fit's shortfall is the larger of its shortfalls on the measure's
     grid and on ``measure.BETWEEN_GRID``.
     ``eevee_mode``: for EEVEE, "EXACT" or "CONVERGED" (``EEVEE_MODES``):
@@ -826,8 +825,6 @@ def fit_lut(
         raise ValueError(f"extra_budget must be a whole number >= 0, got {extra_budget!r}")
     if row_sets is None:
         row_sets = DEFAULT_ROW_SETS[target]
-        if float(lut.meta["type"]["slope"]) == 0.0 or lut.meta["type"]["distribution"] != "exponential":
-            row_sets = tuple(r for r in row_sets if not r.endswith("mirror"))
     row_sets = tuple(validate_row_set(r) for r in row_sets)
     if not row_sets:
         raise ValueError(f"row_sets must name at least one of {', '.join(ROW_SETS)}")
