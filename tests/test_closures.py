@@ -493,3 +493,42 @@ def test_a_sharp_exponential_peak_is_drawn_to_its_top_and_between_the_measures_p
     goals = measure.goals("CYCLES", False)
     assert whole < goals[0] and band < goals[1], (whole, band)
     assert fitted.error(amps) < goals[0], fitted.error(amps)
+
+
+def _dense_binned(fitted, paint, amps, count=100_000, seed=11):
+    """A fit's radiance against the model at random geometries (fixed seed),
+    binned on the measure's grid as the sphere renders are
+    (``bench.binned_errors``): what a curved object shows between the
+    grid's points. (whole, grazing band)."""
+    rng = np.random.default_rng(seed)
+    tl = rng.uniform(0.0, np.radians(78.0), count)
+    tv = rng.uniform(np.radians(2.0), np.radians(78.0), count)
+    ph = rng.uniform(-np.pi, np.pi, count)
+    model = paint.brdf(tl, tv, ph) * np.cos(tl)[:, None]
+    whole, band, _ = bench.binned_errors(tl, tv, ph, fitted.radiance(amps, tl, tv, ph), model, smooth=False)
+    return whole, band
+
+
+@pytest.mark.parametrize("label", ["#6 exp 0.0964 g -0.25", "#21 exp 0.0785 g +0.41"])
+def test_default_cycles_fits_of_sharp_cusps_hold_on_every_pixel_not_only_the_grid(tmp_path, label):
+    """Near-smooth exponential slopes peak in a cusp at the mirror, which
+    the measure's grid samples exactly at each of its views.  The default
+    fit, binned over random geometries as a sphere's pixels are, is within
+    the rough goals (or 1.5x what it reports, as the Cycles sphere test
+    allows) and no worse than its reported figure + 0.5%.  The control:
+    fitted to the grid's mirror points (the mirror sets), the same paint's
+    reported figure is beaten from the wrong side on #6: it reads 2.2% on
+    the grid and renders 5.3% between its points."""
+    paint = dict(bench.random_paints())[label]
+    table = baking.load_lut(baking.bake(paint, tmp_path))
+    amps = table.amplitudes(paint)
+    goals = measure.goals("CYCLES", False)
+    fitted = fitting.fit_lut(table, "CYCLES")
+    reported = (fitted.error(amps), fitted.grazing_error(amps))
+    dense = _dense_binned(fitted, paint, amps)
+    for got, promised, goal in zip(dense, reported, goals, strict=True):
+        assert got <= (goal if promised <= goal else 1.5 * promised), (label, dense, reported)
+        assert got <= promised + 0.005, (label, dense, reported)
+    if label.startswith("#6 "):
+        grid_fit = fitting.fit_lut(table, "CYCLES", row_sets=MIRROR_SETS)
+        assert _dense_binned(grid_fit, paint, amps)[0] > grid_fit.error(amps) + 0.005
