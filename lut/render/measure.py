@@ -36,6 +36,15 @@ GRID = (
 #: (``lut.render.fitting.fit_lut``; the "CYCLES between" figures of
 #: ``scripts/fit_fidelity.py``).
 BETWEEN_GRID = (np.radians(np.arange(2.5, 75.0, 5.0)), GRID[1], GRID[2])
+#: The measure's grid shifted half a step on all three axes (θl 2.5-72.5°,
+#: θv 7.5-72.5°, φ 5-175°): geometries between the measure's in every
+#: direction, as the pixels of a curved object fall.  A fit that draws a
+#: cusp to its top at the measure's mirror points can hold with the lights
+#: alone shifted (``BETWEEN_GRID``) and still miss here, or the other way
+#: round: the fit checks both (``lut.render.fitting.fit_lut``).
+SHIFTED_GRID = (BETWEEN_GRID[0], np.radians(np.arange(7.5, 75.0, 5.0)), np.radians(np.arange(5.0, 180.0, 10.0)))
+#: The grids by name: the measure's own and its two checks.
+GRIDS = {"measure": GRID, "between": BETWEEN_GRID, "shifted": SHIFTED_GRID}
 #: Smooth paints: geometries this close to the mirror direction are left out.
 MIRROR_EXCLUSION = np.radians(5.0)
 #: The grazing band: lights at least this far from the normal.
