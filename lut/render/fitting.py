@@ -17,12 +17,12 @@ The fit, per render target (``fit_lut``):
    not extrapolated); each row is radiance
    L = f·cos θl weighted by its share of the fidelity measure
    (``lut.render.measure``: uniform in θl and φ, dθl dφ = dω/sin θl with
-   dω_l = 4 (h·v) dω_h) and nothing further; for Cycles types of
-   exponential slopes also
-   the exact mirror direction of each view as one cell of the measure's
-   lattice (``mirror_rows``: the measure's grid holds it, and a cusp-like
-   peak narrower than its steps weighs there as its top).  Targets come
-   from the LUT.
+   dω_l = 4 (h·v) dω_h) and nothing further; for a rough Cycles type that
+   misses a goal on those rows, also the exact mirror direction of each
+   view at a small weight (``FALLBACK_ROW_SETS``, ``mirror_rows``: the
+   measure's grid holds it, and a cusp-like peak narrower than its steps
+   weighs there as its top), kept only where it holds between the grid's
+   points too (``gains_everywhere``).  Targets come from the LUT.
 2. Selection.  Forward selection: from the target's candidate closures,
    repeatedly add the one that most reduces the sum over components of the
    squared relative error on the measure, views weighted by their share of
@@ -32,7 +32,7 @@ The fit, per render target (``fit_lut``):
    unconstrained ranking), until the render
    cost budget (closures per material) is spent or the error is far below
    target.  The selection is made on each set of rows of ``DEFAULT_ROW_SETS``
-   and the one nearest the goals kept.  Where a component's error on the
+   and the one nearest the goals kept (then ``FALLBACK_ROW_SETS``, step 1).  Where a component's error on the
    measure (step 4) is then still above the target (some colour of the type would miss it),
    the selection is made again with a few closures more (``EXTRA_BUDGET``)
    and kept if it lowers that error.  Grey closures (no colour input)
@@ -832,9 +832,11 @@ def fit_lut(
     None: Cycles' formulas, EEVEE's own rendering unmodelled).  ``row_sets``:
     the rows to fit on, tried in turn (``ROW_SETS``) until a fit meets its
     goals; the fit kept is the one nearest them (``shortfall``); None: the
-    target's ``DEFAULT_ROW_SETS`` (none with the mirror point).  Where a set with the mirror point is tried,
-    each fit's shortfall is the larger of its shortfalls on the measure's
-    grid and on ``measure.BETWEEN_GRID``.
+    target's ``DEFAULT_ROW_SETS``, then for a rough type that misses a goal
+    on them its ``FALLBACK_ROW_SETS``, kept only where ``gains_everywhere``.
+    Where a set with the mirror point is tried, each fit's shortfall is the
+    largest of its shortfalls on the measure's grid, on
+    ``measure.BETWEEN_GRID`` and on ``measure.SHIFTED_GRID``.
     ``eevee_mode``: for EEVEE, "EXACT" or "CONVERGED" (``EEVEE_MODES``):
     where the exact fit misses a goal, a converged one of up to
     ``converged_budget`` closures (+ ``converged_extra``) is fitted too and
