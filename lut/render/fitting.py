@@ -183,7 +183,8 @@ DEFAULT_ROW_SETS = {
     "EEVEE": ("hemisphere", "grazing"),
 }
 #: The rows a default fit of an exponential type (whose facet term peaks in
-#: a cusp) tries next where the default sets miss a goal on the measure's grid: "grazing-cusp", the "grazing" rows and
+#: a cusp) tries next where its facet term misses a goal on the default
+#: sets' rows (on the measure's grid): "grazing-cusp", the "grazing" rows and
 #: each view's mirror point at ``CUSP_WEIGHT`` of the mirror sets' weight.
 #: Both fits are then scored on the grid and on its two checks between its
 #: points (``measure.BETWEEN_GRID``, lights shifted half a step, and
@@ -910,8 +911,11 @@ def fit_lut(
             best, best_rows = fitted, row_set
         if best[-1] <= 1.0:  # every colour of the type meets both goals: the next sets need not be tried
             break
-    if best[-1] > 1.0 and fallback:
-        # A miss on the default rows: try the mirror point at a small weight,
+    facet = [v for (c, _), v in goal_ratios(*best[2:4], goals).items() if c == "facet"]
+    if fallback and max(facet, default=0.0) > 1.0:
+        # The facet term misses on the default rows (the cusp is its; a miss
+        # of the other components alone is not refitted, at 0.8-1.5 s a fit):
+        # try the mirror point at a small weight,
         # and keep it only where it brings every component nearer its goals
         # (or keeps it within them) on the grid and between the grid's
         # points alike (``gains_everywhere``, both fits checked).
