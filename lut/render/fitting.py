@@ -17,8 +17,8 @@ The fit, per render target (``fit_lut``):
    not extrapolated); each row is radiance
    L = f·cos θl weighted by its share of the fidelity measure
    (``lut.render.measure``: uniform in θl and φ, dθl dφ = dω/sin θl with
-   dω_l = 4 (h·v) dω_h) and nothing further; for a rough Cycles type that
-   misses a goal on those rows, also the exact mirror direction of each
+   dω_l = 4 (h·v) dω_h) and nothing further; for an exponential Cycles
+   type whose facet term misses a goal on those rows, also the exact mirror direction of each
    view at a small weight (``FALLBACK_ROW_SETS``, ``mirror_rows``: the
    measure's grid holds it, and a cusp-like peak narrower than its steps
    weighs there as its top), kept only where it holds between the grid's
@@ -833,8 +833,9 @@ def fit_lut(
     None: Cycles' formulas, EEVEE's own rendering unmodelled).  ``row_sets``:
     the rows to fit on, tried in turn (``ROW_SETS``) until a fit meets its
     goals; the fit kept is the one nearest them (``shortfall``); None: the
-    target's ``DEFAULT_ROW_SETS``, then for a rough type that misses a goal
-    on them its ``FALLBACK_ROW_SETS``, kept only where ``gains_everywhere``.
+    target's ``DEFAULT_ROW_SETS``, then for an exponential type whose facet
+    term misses a goal on them its ``FALLBACK_ROW_SETS``, kept only where
+    ``gains_everywhere``.
     Where a set with the mirror point is tried, each fit's shortfall is the
     largest of its shortfalls on the measure's grid, on
     ``measure.BETWEEN_GRID`` and on ``measure.SHIFTED_GRID``.
