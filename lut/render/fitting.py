@@ -18,11 +18,12 @@ The fit, per render target (``fit_lut``):
    L = f·cos θl weighted by its share of the fidelity measure
    (``lut.render.measure``: uniform in θl and φ, dθl dφ = dω/sin θl with
    dω_l = 4 (h·v) dω_h) and nothing further; for an exponential Cycles
-   type whose facet term misses a goal on those rows, also the exact mirror direction of each
-   view at a small weight (``FALLBACK_ROW_SETS``, ``mirror_rows``: the
-   measure's grid holds it, and a cusp-like peak narrower than its steps
-   weighs there as its top), kept only where it holds between the grid's
-   points too (``gains_everywhere``).  Targets come from the LUT.
+   type whose facet term misses a goal on those rows, also the exact
+   mirror direction of each view at a small weight (``FALLBACK_ROW_SETS``,
+   ``mirror_rows``: the measure's grid holds it, and a cusp-like peak
+   narrower than its steps weighs there as its top), kept only where it
+   holds between the grid's points too (``gains_everywhere``).  Targets
+   come from the LUT.
 2. Selection.  Forward selection: from the target's candidate closures,
    repeatedly add the one that most reduces the sum over components of the
    squared relative error on the measure, views weighted by their share of
@@ -1285,20 +1286,27 @@ def gains_everywhere(before: dict, after: dict, margin=FALLBACK_GAIN) -> bool:
     return sum(v * v for v in after.values()) < (1.0 - margin) * sum(v * v for v in before.values())
 
 
-def _has_mirror(row_set) -> bool:
-    """Whether a row set (``ROW_SETS``) holds the exact mirror point of each view."""
-    return row_set in ("mirror", "lattice", "grazing-mirror", "grazing-cusp")
-
-
-def _rows(row_set, theta_v, grid):
-    """The fit's rows of a row set (``ROW_SETS``): (θl, φ, weight), (M, R)."""
-    rows = light_rows(theta_v, grid)
-    extra = {
+def _extra_rows(row_set):
+    """The rows a row set (``ROW_SETS``) adds to the hemisphere's: a function
+    of the views, each holding the exact mirror point of every view; None
+    for the sets without them."""
+    return {
         "lattice": lattice_rows,
         "mirror": mirror_rows,
         "grazing-mirror": mirror_rows,
         "grazing-cusp": functools.partial(mirror_rows, weight=CUSP_WEIGHT),
     }.get(row_set)
+
+
+def _has_mirror(row_set) -> bool:
+    """Whether a row set (``ROW_SETS``) holds the exact mirror point of each view."""
+    return _extra_rows(row_set) is not None
+
+
+def _rows(row_set, theta_v, grid):
+    """The fit's rows of a row set (``ROW_SETS``): (θl, φ, weight), (M, R)."""
+    rows = light_rows(theta_v, grid)
+    extra = _extra_rows(row_set)
     if extra is not None:
         rows = tuple(np.concatenate([x, y], axis=1) for x, y in zip(rows, extra(theta_v), strict=True))
     theta_l, phi, weight = rows
