@@ -539,8 +539,9 @@ def test_default_cycles_fits_of_sharp_cusps_hold_on_every_pixel_not_only_the_gri
 def test_a_cusp_the_default_rows_miss_tries_its_mirror_point_and_keeps_it_only_where_it_holds_between(
     tmp_path, label, gains
 ):
-    """Where the default rows miss a goal on a rough type, the fit tries the
-    mirror point at a quarter weight ("grazing-cusp") and keeps it only
+    """Where an exponential type's facet term misses a goal on the default
+    rows, the fit tries the mirror point at a quarter weight ("grazing-cusp")
+    and keeps it only
     where it comes nearer the goals on the grid and between the grid's
     points alike.  #21 gains (6.3% -> 2.9% on the grid, within the goal
     between its points too); #6 keeps the default rows' fit, as the cusp
